@@ -1,0 +1,56 @@
+// SampleSet: BRDF samples as a structure of arrays (directions, RGB values,
+// optional weights, validity), and the builders that make one from a BRDF
+// (regular parabolic grid, stratified random) or a sample-list CSV.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "brdfs/brdf.h"
+
+namespace bf {
+
+struct SampleSet {
+  // Per sample k (all vectors have size() entries):
+  std::vector<Vec3> wi;       // unit, local frame, towards the light
+  std::vector<Vec3> wo;       // unit, local frame, towards the viewer
+  std::vector<Rgb> value;     // f(wi, wo) in 1/sr; meaningful only where valid
+  std::vector<double> weight; // empty = every weight is 1; else >= 0 per sample
+  std::vector<uint8_t> valid; // 1 = used by fits and metrics, 0 = masked
+  std::string description;    // provenance, e.g. "grid 16^4 of bluepaint"
+
+  // Counts of masked samples by reason (filled by validate()).
+  size_t invalid_value = 0;    // NaN, Inf or negative in any channel
+  size_t invalid_horizon = 0;  // wi.z <= 0 or wo.z <= 0
+  size_t invalid_weight = 0;   // NaN, Inf or negative weight
+
+  size_t size() const { return wi.size(); }
+  size_t valid_count() const;
+  double weight_of(size_t k) const { return weight.empty() ? 1.0 : weight[k]; }
+  void push(const Vec3& i, const Vec3& o, const Rgb& v, double w = 1.0);
+  // Recomputes valid[] and the invalid_* counts from the data. Never throws.
+  void validate();
+  // "43264 samples (0 masked)" or "1439 samples (12 masked: 12 value, 0 horizon, 0 weight)".
+  std::string summary() const;
+  // Keeps only the valid samples (in order).
+  SampleSet compacted() const;
+};
+
+// Regular res^4 grid: res points per parabolic axis at cell centres
+// (-1 + (k + 0.5) * 2 / res), kept where both parabolic points lie in the unit
+// disk. res = 16 gives 208 directions per disk and 43,264 pairs.
+// Throws std::invalid_argument for res < 2 or res > 256.
+SampleSet sample_grid(const Brdf& brdf, int res);
+// Directions of the res x res grid that lie in the disk (the per-disk set above).
+std::vector<Vec3> grid_directions(int res);
+
+// count pairs, Latin-hypercube stratified in (cos theta_i, phi_i, cos theta_o,
+// phi_o), uniform in solid angle; deterministic for a seed.
+// Throws std::invalid_argument for count == 0 or count > 1e8.
+SampleSet sample_stratified(const Brdf& brdf, size_t count, uint64_t seed);
+
+// Evaluates brdf at the given direction pairs (values of an existing set are replaced).
+void evaluate_into(const Brdf& brdf, SampleSet& s);
+
+}  // namespace bf

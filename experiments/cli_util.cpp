@@ -1,0 +1,66 @@
+// CLI helpers (see cli_util.h).
+#include "experiments/cli_util.h"
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+#include <vector>
+
+namespace bf {
+
+Vec3 parse_direction(const std::string& text, const std::string& what) {
+  std::vector<double> v;
+  std::stringstream ss(text);
+  std::string part;
+  while (std::getline(ss, part, ',')) {
+    try {
+      size_t pos = 0;
+      const double d = std::stod(part, &pos);
+      if (pos != part.size() || !std::isfinite(d)) throw std::invalid_argument("x");
+      v.push_back(d);
+    } catch (const std::exception&) {
+      throw std::invalid_argument(what + ": expected three numbers x,y,z, found '" + text + "'");
+    }
+  }
+  if (v.size() != 3)
+    throw std::invalid_argument(what + ": expected three numbers x,y,z, found " +
+                                std::to_string(v.size()) + " in '" + text + "'");
+  Vec3 w(v[0], v[1], v[2]);
+  const double n = w.norm();
+  if (!(n > 1e-12)) throw std::invalid_argument(what + ": direction must be non-zero");
+  return w / n;
+}
+
+void write_file_atomic(const std::string& path, const std::function<void(std::ostream&)>& body) {
+  namespace fs = std::filesystem;
+  const fs::path p(path);
+  if (p.has_parent_path()) {
+    std::error_code ec;
+    fs::create_directories(p.parent_path(), ec);
+    if (ec)
+      throw std::runtime_error(path + ": cannot create folder " + p.parent_path().string() + ": " +
+                               ec.message());
+  }
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream out(tmp, std::ios::binary);
+    if (!out) throw std::runtime_error(path + ": cannot open for writing");
+    body(out);
+    out.flush();
+    if (!out) {
+      std::remove(tmp.c_str());
+      throw std::runtime_error(path + ": write failed (disk full?)");
+    }
+  }
+  std::error_code ec;
+  fs::rename(tmp, path, ec);
+  if (ec) {
+    std::remove(tmp.c_str());
+    throw std::runtime_error(path + ": cannot rename temporary file: " + ec.message());
+  }
+}
+
+}  // namespace bf

@@ -1,0 +1,23 @@
+// Small helpers shared by the subcommands: strict vector parsing and
+// atomically written output files.
+#pragma once
+
+#include <functional>
+#include <ostream>
+#include <string>
+
+#include "brdfs/brdf.h"
+
+namespace bf {
+
+// Parses "x,y,z" (three finite numbers) into a unit vector; `what` names the
+// option in messages ("--wi"). Throws std::invalid_argument on malformed input
+// or a zero vector. Non-unit input is normalized.
+Vec3 parse_direction(const std::string& text, const std::string& what);
+
+// Writes a file through a temporary next to it and renames it into place, so a
+// reader never sees a half-written file. Throws std::runtime_error naming the
+// path when it cannot be written.
+void write_file_atomic(const std::string& path, const std::function<void(std::ostream&)>& body);
+
+}  // namespace bf

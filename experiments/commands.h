@@ -1,0 +1,14 @@
+// The brdf-factor subcommands: each add_cmd_* registers one subcommand (its
+// options and the callback that runs it) on the CLI11 app. Callbacks throw on
+// error; main() turns any exception into a one-line message and exit code 2.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+namespace bf {
+
+void add_cmd_list(CLI::App& app);    // cmd_basic.cpp
+void add_cmd_eval(CLI::App& app);    // cmd_basic.cpp
+void add_cmd_sample(CLI::App& app);  // cmd_basic.cpp
+
+}  // namespace bf

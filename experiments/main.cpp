@@ -1,0 +1,31 @@
+// brdf-factor: the command-line entry point. Subcommands are registered from
+// commands.h; every error becomes one line on stderr and exit code 2.
+#include <CLI/CLI.hpp>
+#include <exception>
+#include <iostream>
+
+#include "experiments/commands.h"
+
+int main(int argc, char** argv) {
+  CLI::App app{"brdf-factor: BRDF factorization toolkit (homomorphic fits, projection search, "
+               "SVD and SH baselines)"};
+  app.require_subcommand(1);
+  app.get_formatter()->column_width(36);
+  bf::add_cmd_list(app);
+  bf::add_cmd_eval(app);
+  bf::add_cmd_sample(app);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    std::cerr << "brdf-factor: " << e.what() << " (see brdf-factor --help)\n";
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << "brdf-factor: " << e.what() << "\n";
+    return 2;
+  }
+  return 0;
+}

@@ -1,0 +1,39 @@
+#!/usr/bin/env bash
+# Installs every Debian 12 package brdf-factor needs to build, test and make its
+# reports. Idempotent: packages already present are not touched, and apt is only
+# called when something is missing. Run as root (or with sudo available).
+set -euo pipefail
+
+PACKAGES=(
+  build-essential cmake ninja-build pkg-config
+  libeigen3-dev          # linear algebra (3.4)
+  libceres-dev           # nonlinear least squares (2.1)
+  libopenimageio-dev     # EXR/PNG I/O (2.4)
+  libopenexr-dev         # EXR (3.1)
+  libnlopt-cxx-dev       # alternative optimizers (2.7)
+  catch2                 # tests (2.13)
+  libtomlplusplus-dev    # TOML configs
+  nlohmann-json3-dev     # JSON sidecars and manifests
+  libcli11-dev           # command-line parsing
+  glslang-tools          # compiles the generated GLSL in a test
+  python3-matplotlib     # plots in experiment reports
+)
+
+missing=()
+for p in "${PACKAGES[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$p")
+  fi
+done
+
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "install-deps: all ${#PACKAGES[@]} packages present"
+  exit 0
+fi
+
+SUDO=""
+if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
+echo "install-deps: installing ${missing[*]}"
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update -qq
+$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
