@@ -1,0 +1,65 @@
+// The homomorphic (log-space) factorization of McCool / Cole:
+//   f(wi, wo) ~= A * exp( sum_j  t_j(pi_j(x)) [+ t_j(pi_j*(x)) if reciprocal] )  [- eps*A]
+// per RGB channel, with x the point of (wi, wo) in the term's parameterization,
+// t_j the term's log-space texture read with bilinear interpolation, and A the
+// per-channel mean of f over the fitted samples (DESIGN.md §2).
+#pragma once
+
+#include <array>
+#include <optional>
+#include <vector>
+
+#include "factor/factorization.h"
+#include "factor/projection.h"
+
+namespace bf {
+
+struct FactorTerm {
+  Projection proj;
+  bool reciprocal = false;  // texture also read through proj.conjugate()
+  // Log-space texels, per channel, res*res floats (index j*res+i). Stored as
+  // float: this is exactly what the EXR export holds, so a reloaded export
+  // evaluates bit-identically. Texels outside `mask` are 0 and never read by
+  // points inside the 4-cube.
+  std::array<std::vector<float>, 3> texels;
+  std::vector<uint8_t> mask;  // projection_mask(proj), 1 = unknown of the fit
+  // Where the projection came from, if from a 4D rotation: the quaternion pair
+  // (S, T), each [w, x, y, z]. Informational (export, manifest).
+  std::optional<std::array<double, 8>> rotation;
+
+  size_t mask_count() const;
+  // Bilinear lookup of the log texture, channel c, at texture coordinates s.
+  double lookup(int c, const Eigen::Vector2d& s) const;
+};
+
+class HomomorphicFactorization final : public Factorization {
+ public:
+  HomomorphicFactorization(std::vector<FactorTerm> terms, Rgb A, double eps, bool subtract_eps,
+                           std::string method);
+
+  Rgb eval(const Vec3& wi, const Vec3& wo) const override;
+  // Log-space model value sum_j t_j(...) per channel (no A, no eps).
+  Rgb eval_log(const Vec3& wi, const Vec3& wo) const;
+  std::string name() const override { return method_; }
+  std::string to_string() const override;
+  bool reciprocal() const override;
+  bool isotropic() const override { return false; }
+  std::string method() const override { return method_; }
+  // Masked texels x 3 channels for every term, + 3 (A) + 1 (eps).
+  size_t storage_floats() const override;
+  nlohmann::json describe() const override;
+
+  const std::vector<FactorTerm>& terms() const { return terms_; }
+  const Rgb& A() const { return A_; }
+  double eps() const { return eps_; }
+  bool subtract_eps() const { return subtract_eps_; }
+
+ private:
+  std::vector<FactorTerm> terms_;
+  Rgb A_;
+  double eps_;
+  bool subtract_eps_;
+  std::string method_;
+};
+
+}  // namespace bf

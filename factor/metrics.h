@@ -1,0 +1,39 @@
+// Error metrics of DESIGN.md §4: one definition, used by every method, on the
+// same samples, so numbers in one table are comparable.
+#pragma once
+
+#include <string>
+
+#include "brdfs/brdf.h"
+#include "brdfs/sampleset.h"
+
+namespace bf {
+
+// McCool's log transform (thesis eq. 1.9): g = log((f + eps*A) / A), with A the
+// per-channel mean of f over the valid samples (unweighted).
+struct LogTransform {
+  Rgb A = Rgb::Ones();
+  double eps = 1e-5;
+  // Throws std::invalid_argument if s has no valid sample, if eps is not in
+  // (0, 1], or if a channel's mean is 0 (all-zero BRDF: nothing to factor).
+  static LogTransform of(const SampleSet& s, double eps = 1e-5);
+  double g(int c, double f) const { return std::log((std::max(f, 0.0) + eps * A[c]) / A[c]); }
+};
+
+struct Metrics {
+  double rel_mse = 0, rel_mae = 0, rel_max = 0;    // on g (log space)
+  double lin_rmse = 0, lin_mae = 0, lin_max = 0;   // on f (1/sr)
+  double cos_rmse = 0;                              // on (f_approx - f) cos(theta_i)
+  size_t samples = 0;                               // valid samples scored
+};
+
+// Scores approx against the valid samples of s (weights w_k from s, 1 if none),
+// over the three channels. Non-finite approximation values count as an error of
+// 1e300 in every metric (never NaN). Throws if s has no valid sample or the
+// weights sum to 0.
+Metrics evaluate_metrics(const Brdf& approx, const SampleSet& s, const LogTransform& t);
+
+// The metric named `name` ("rel_mse", ..., "cos_rmse"); throws for unknown names.
+double metric_value(const Metrics& m, const std::string& name);
+
+}  // namespace bf
