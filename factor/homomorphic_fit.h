@@ -1,0 +1,112 @@
+// McCool's homomorphic least-squares fit for given projections (thesis 3.2):
+// log transform, bilinear weights, projection masks, Laplacian smoothing,
+// optional reciprocity, the last n terms solved jointly with earlier ones
+// fixed, one Cholesky factorization of the normal matrix for all three RGB
+// channels.
+//
+// The linear system. For the n joint terms with unknown log texels y, every
+// valid sample k gives one row b_k (bilinear weights of its projected positions,
+// conjugate positions added for reciprocal terms) and target
+// r_k = g_k - (sum of the fixed terms at k). We minimize
+//   sum_k w_k (b_k . y - r_k)^2 + mu * sum_terms |L y_t|^2 + gauge
+// through the normal equations (B^T W B + mu L^T L + G) y = B^T W r, assembled
+// directly (B is never formed densely), solved by Cholesky (dense LLT for small
+// systems, sparse LLT for large textures).
+//  - L is the graph Laplacian of each term's mask (4-neighbours inside the
+//    mask): its null space is the constants only.
+//  - mu = smoothing * (sum of sample weights) / (number of unknowns): the
+//    smoothing option is relative to the average sample weight per texel.
+//  - Gauge: adding c to one joint term and subtracting it from another changes
+//    nothing (bilinear weights sum to 1, L ignores constants), so the normal
+//    matrix would be singular. We pin the freedom explicitly: for the 2nd..n-th
+//    joint term the penalty gamma * (sum of its texels)^2 is added (dense and
+//    QR paths; the sparse path penalizes that term's first texel instead, which
+//    keeps the matrix sparse), which forces their texel sums (or first texel)
+//    to 0 without changing the fitted function: the constant lands in the
+//    first joint term. Paths agree on the function, not on the split. A ridge of 1e-12 * mean diagonal guards
+//    against any remaining exact singularity (a texel nothing constrains).
+#pragma once
+
+#include <array>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "brdfs/sampleset.h"
+#include "factor/homomorphic.h"
+#include "factor/metrics.h"
+
+namespace bf {
+
+struct FitOptions {
+  double eps = 1e-5;         // log-transform epsilon (DESIGN.md §2), 0 < eps <= 1
+  double smoothing = 1e-3;   // Laplacian weight relative to the mean sample weight per texel, >= 0
+  bool subtract_eps = true;  // reconstruct A exp(s) - eps A (clamped at 0) instead of A exp(s)
+  int solve_last = 2;        // n: the last n terms are solved jointly, >= 1
+  // Dense: normal matrix assembled densely, LLT. Sparse: B assembled sparse,
+  // B^T W B by sparse product, SimplicialLLT (AMD ordering). Auto: dense up to
+  // 2500 unknowns, sparse above (measured crossover, README). ReferenceQR: the
+  // simple path (dense B, Householder QR, no normal equations) for tests.
+  enum class Solver { Auto, Dense, Sparse, ReferenceQR } solver = Solver::Auto;
+  // Throws std::invalid_argument naming the field, its value and the rule.
+  void validate() const;
+};
+
+struct TermSpec {
+  Projection proj;
+  bool reciprocal = false;
+  std::optional<std::array<double, 8>> rotation;  // quaternion pair, informational
+};
+
+// Per-sample data shared by every fit on the same samples: the valid samples
+// only, their points in both parameterizations, log-space targets g (3
+// channels) and weights.
+class FitData {
+ public:
+  // Throws if s has no valid sample or a channel is all zero (see LogTransform::of).
+  FitData(const SampleSet& s, double eps);
+  size_t size() const { return w.size(); }
+
+  LogTransform transform;
+  std::vector<Vec4> x_wiwo, x_halfdiff;  // per valid sample
+  std::vector<double> w;                 // weight per valid sample
+  double W = 0;                          // sum of w
+  std::array<std::vector<double>, 3> g;  // log-space target per channel
+  const std::vector<Vec4>& points(Parameterization p) const {
+    return p == Parameterization::WiWo ? x_wiwo : x_halfdiff;
+  }
+};
+
+struct JointSolution {
+  std::vector<FactorTerm> terms;  // the joint terms with texels and masks
+  double rel_mse = 0;             // objective of fixed + joint terms on the fit data
+  size_t unknowns = 0;            // texels solved for (all joint terms)
+};
+
+// Sum of the given (fixed) terms' log values at every sample, per channel.
+std::array<std::vector<double>, 3> fixed_sum(const FitData& d, const std::vector<FactorTerm>& fixed);
+
+// Solves `joint` with `fixed_values` (from fixed_sum) held. Throws
+// std::invalid_argument for invalid projections, std::runtime_error if the
+// normal matrix is not positive definite.
+JointSolution solve_joint(const FitData& d, const std::array<std::vector<double>, 3>& fixed_values,
+                          const std::vector<TermSpec>& joint, const FitOptions& opt);
+
+// rel_mse of a log-space model value s against target g (both per sample and
+// channel), with the reconstruction's clamping applied exactly as the metrics
+// see it: g_approx = max(s, log eps) if subtract_eps, else log(exp(s) + eps).
+double model_log_value(double s, const FitOptions& opt);
+
+// The full schedule of thesis 3.2.2 for given projections: for j = 1..J, terms
+// max(1, j-n+1)..j are solved jointly with earlier terms fixed at their values.
+// `errors_after_term`, if given, receives the rel_mse after each j.
+std::shared_ptr<HomomorphicFactorization> fit_homomorphic(
+    const FitData& d, const std::vector<TermSpec>& terms, const FitOptions& opt,
+    const std::string& method = "fit", std::vector<double>* errors_after_term = nullptr);
+
+// McCool's fixed projections (thesis 2.1.1): p(wi) and p(wo) share one texture
+// (a reciprocal wiwo term), q(h) has its own (halfdiff, first pair; h through
+// the parabolic map). Two textures of size res.
+std::vector<TermSpec> mccool_terms(int res);
+
+}  // namespace bf

@@ -1,0 +1,206 @@
+// Tests of the homomorphic fit: planted solutions, bilinear convergence,
+// reciprocity, McCool's form, fast path vs reference path, degenerate input.
+#include <cmath>
+#include <random>
+
+#include "brdfs/models.h"
+#include "brdfs/sampleset.h"
+#include "factor/homomorphic_fit.h"
+#include "factor/metrics.h"
+#include "fit_helpers.h"
+#include "test_common.h"
+
+using namespace bf;
+using bf_test::McCoolFormBrdf;
+using bf_test::PlantedBrdf;
+
+namespace {
+std::vector<TermSpec> planted_terms(int res) {
+  return {{projection_first_pair(Parameterization::WiWo, res), false, std::nullopt},
+          {projection_second_pair(Parameterization::WiWo, res), false, std::nullopt},
+          {projection_first_pair(Parameterization::HalfDiff, res), false, std::nullopt}};
+}
+}  // namespace
+
+TEST_CASE("fit: a planted product-separable BRDF is recovered with its own projections") {
+  const PlantedBrdf brdf;
+  const SampleSet s = sample_stratified(brdf, 40000, 1);
+  FitOptions opt;
+  opt.solve_last = 3;
+  opt.smoothing = 1e-6;
+  const FitData d(s, opt.eps);
+  // All three terms jointly (solve_last = 3), without the greedy schedule.
+  std::array<std::vector<double>, 3> zero;
+  for (auto& z : zero) z.assign(d.size(), 0.0);
+  const JointSolution sol = solve_joint(d, zero, planted_terms(32), opt);
+  const auto f = std::make_shared<HomomorphicFactorization>(sol.terms, d.transform.A, opt.eps,
+                                                            true, "fit");
+  const Metrics m = evaluate_metrics(*f, s, d.transform);
+  INFO("rel_mse at texture 32 = " << m.rel_mse);
+  CHECK(m.rel_mse < 1e-4);
+  // The three textures reproduce the factors up to constants: compare the
+  // recovered log texture of a(wi) at two points against log a difference.
+  const SampleSet held = sample_stratified(brdf, 5000, 99);
+  CHECK(evaluate_metrics(*f, held, d.transform).rel_mse < 1e-4);
+}
+
+TEST_CASE("fit: RMS log error falls about 4x per doubling of texture resolution") {
+  // Bilinear reconstruction of smooth factors converges as h^2. Fit on dense
+  // stratified samples, score on held-out ones, texture 8 -> 16 -> 32 (64 in [slow]).
+  const PlantedBrdf brdf;
+  const SampleSet fit_s = sample_stratified(brdf, 60000, 2);
+  const SampleSet held = sample_stratified(brdf, 8000, 3);
+  FitOptions opt;
+  opt.solve_last = 3;
+  opt.smoothing = 1e-7;
+  const FitData d(fit_s, opt.eps);
+  std::vector<double> rms;
+  for (int res : {8, 16, 32}) {
+    const auto f = fit_homomorphic(d, planted_terms(res), opt);
+    rms.push_back(std::sqrt(evaluate_metrics(*f, held, d.transform).rel_mse));
+  }
+  for (size_t i = 1; i < rms.size(); ++i) {
+    const double ratio = rms[i - 1] / rms[i];
+    INFO("rms " << rms[i - 1] << " -> " << rms[i] << " ratio " << ratio);
+    CHECK(ratio > 3.0);
+    CHECK(ratio < 5.5);
+  }
+}
+
+TEST_CASE("fit: convergence continues to texture 64", "[slow]") {
+  const PlantedBrdf brdf;
+  const SampleSet fit_s = sample_stratified(brdf, 250000, 4);
+  const SampleSet held = sample_stratified(brdf, 8000, 5);
+  FitOptions opt;
+  opt.solve_last = 3;
+  opt.smoothing = 1e-7;
+  const FitData d(fit_s, opt.eps);
+  const double r32 =
+      std::sqrt(evaluate_metrics(*fit_homomorphic(d, planted_terms(32), opt), held, d.transform).rel_mse);
+  const double r64 =
+      std::sqrt(evaluate_metrics(*fit_homomorphic(d, planted_terms(64), opt), held, d.transform).rel_mse);
+  INFO("rms 32: " << r32 << " 64: " << r64);
+  CHECK(r32 / r64 > 3.0);
+}
+
+TEST_CASE("fit: reciprocal fits are exactly reciprocal") {
+  const PlantedBrdf brdf;  // itself not reciprocal: the constraint must do the work
+  const SampleSet s = sample_stratified(brdf, 8000, 7);
+  std::mt19937_64 rng(5);
+  std::vector<TermSpec> terms;
+  terms.push_back({bf_test::random_projection(rng, Parameterization::WiWo, 12), true, std::nullopt});
+  terms.push_back({bf_test::random_projection(rng, Parameterization::HalfDiff, 12), true, std::nullopt});
+  terms.push_back({bf_test::random_projection(rng, Parameterization::WiWo, 12), true, std::nullopt});
+  FitOptions opt;
+  const FitData d(s, opt.eps);
+  const auto f = fit_homomorphic(d, terms, opt);
+  CHECK(f->reciprocal());
+  const SampleSet probe = sample_stratified(brdf, 2000, 8);
+  double worst = 0;
+  for (size_t k = 0; k < probe.size(); ++k) {
+    const Rgb a = f->eval(probe.wi[k], probe.wo[k]), b = f->eval(probe.wo[k], probe.wi[k]);
+    worst = std::max(worst, ((a - b).abs() / a.abs().max(1e-300)).maxCoeff());
+  }
+  INFO("worst relative asymmetry " << worst);
+  CHECK(worst < 1e-12);
+}
+
+TEST_CASE("mccool: a BRDF of McCool's form is recovered to rel_mse < 1e-4 at texture 32") {
+  const McCoolFormBrdf brdf;
+  const SampleSet s = sample_stratified(brdf, 40000, 11);
+  FitOptions opt;
+  opt.smoothing = 1e-6;
+  const FitData d(s, opt.eps);
+  const auto f = fit_homomorphic(d, mccool_terms(32), opt, "mccool");
+  const double e = evaluate_metrics(*f, s, d.transform).rel_mse;
+  INFO("rel_mse " << e);
+  CHECK(e < 1e-4);
+  CHECK(f->reciprocal());
+  CHECK(f->terms().size() == 2);
+}
+
+TEST_CASE("fit: dense and sparse Cholesky agree with the reference QR path") {
+  const PlantedBrdf brdf;
+  const SampleSet s = sample_stratified(brdf, 3000, 13);
+  std::mt19937_64 rng(17);
+  std::vector<TermSpec> joint = {
+      {bf_test::random_projection(rng, Parameterization::WiWo, 8), false, std::nullopt},
+      {bf_test::random_projection(rng, Parameterization::HalfDiff, 8), true, std::nullopt}};
+  FitOptions opt;
+  const FitData d(s, opt.eps);
+  std::array<std::vector<double>, 3> zero;
+  for (auto& z : zero) z.assign(d.size(), 0.0);
+  opt.solver = FitOptions::Solver::ReferenceQR;
+  const JointSolution ref = solve_joint(d, zero, joint, opt);
+  for (auto solver : {FitOptions::Solver::Dense, FitOptions::Solver::Sparse}) {
+    opt.solver = solver;
+    const JointSolution fast = solve_joint(d, zero, joint, opt);
+    CHECK(bf_test::near_rel(fast.rel_mse, ref.rel_mse, 1e-8));
+    // Same fitted function at every sample (the texel split may differ by constants).
+    const HomomorphicFactorization a(fast.terms, d.transform.A, opt.eps, true, "fit");
+    const HomomorphicFactorization b(ref.terms, d.transform.A, opt.eps, true, "fit");
+    double worst = 0;
+    for (size_t k = 0; k < 500; ++k)
+      worst = std::max(worst, (a.eval_log(s.wi[k], s.wo[k]) - b.eval_log(s.wi[k], s.wo[k]))
+                                  .abs()
+                                  .maxCoeff());
+    INFO("solver " << int(solver) << " worst log difference " << worst);
+    CHECK(worst < 1e-5);  // texels are stored as float
+  }
+}
+
+TEST_CASE("fit: the schedule solves the last n terms jointly and error never increases") {
+  const PlantedBrdf brdf;
+  const SampleSet s = sample_stratified(brdf, 6000, 19);
+  FitOptions opt;
+  opt.solve_last = 2;
+  const FitData d(s, opt.eps);
+  std::vector<double> errs;
+  fit_homomorphic(d, planted_terms(12), opt, "fit", &errs);
+  REQUIRE(errs.size() == 3);
+  CHECK(errs[1] <= errs[0] * (1 + 1e-9));
+  CHECK(errs[2] <= errs[1] * (1 + 1e-9));
+}
+
+TEST_CASE("fit: degenerate input gives a clear error or a finite answer") {
+  FitOptions opt;
+  SECTION("zero samples") {
+    SampleSet s;
+    s.validate();
+    CHECK_THROWS_WITH(FitData(s, opt.eps), Catch::Contains("no valid sample"));
+  }
+  SECTION("all-zero BRDF") {
+    const Lambert black(LambertParams{Rgb::Zero()});
+    CHECK_THROWS_WITH(FitData(sample_grid(black, 8), opt.eps), Catch::Contains("all-zero"));
+  }
+  SECTION("samples with zero weight") {
+    SampleSet s = sample_grid(Lambert(LambertParams{}), 6);
+    s.weight.assign(s.size(), 0.0);
+    s.validate();
+    CHECK_THROWS_WITH(FitData(s, opt.eps), Catch::Contains("weights sum to 0"));
+  }
+  SECTION("a projection with parallel rows is rejected") {
+    const FitData d(sample_grid(PlantedBrdf(), 6), opt.eps);
+    TermSpec t{projection_first_pair(Parameterization::WiWo, 8), false, std::nullopt};
+    t.proj.P.row(1) = t.proj.P.row(0);
+    CHECK_THROWS_WITH(fit_homomorphic(d, {t}, opt), Catch::Contains("orthogonal"));
+  }
+  SECTION("data whose image is a point or a segment gives a finite fit") {
+    // Every sample has wi = n: p(wi) collapses to one point, p(wo) x p(wi)
+    // mixtures to a segment. Texels nothing touches are set by the Laplacian.
+    SampleSet s;
+    const PlantedBrdf brdf;
+    for (const Vec3& o : grid_directions(10)) s.push(Vec3(0, 0, 1), o, brdf.eval(Vec3(0, 0, 1), o));
+    s.validate();
+    const FitData d(s, opt.eps);
+    std::vector<TermSpec> terms = planted_terms(16);
+    TermSpec mix{projection_first_pair(Parameterization::WiWo, 16), false, std::nullopt};
+    mix.proj.P << 1, 0, 0, 0, 0, 0, 1, 0;  // (p(wi).x, p(wo).x): a segment for this data
+    terms.push_back(mix);
+    const auto f = fit_homomorphic(d, terms, opt);
+    for (const auto& t : f->terms())
+      for (int c = 0; c < 3; ++c)
+        for (float v : t.texels[c]) REQUIRE(std::isfinite(v));
+    CHECK(evaluate_metrics(*f, s, d.transform).rel_mse < 1e-3);
+  }
+}
