@@ -1,0 +1,504 @@
+// Factor export: EXR textures, PNG previews, JSON sidecar, GLSL; and the loader
+// that reads them back (see export.h).
+#include "factor/export.h"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <OpenImageIO/imageio.h>
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+#include "brdfs/catalogue.h"
+#include "factor/glsl.h"
+
+namespace bf {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+
+const char* const kChannel[3] = {"R", "G", "B"};
+
+// ---------------------------------------------------------------- writing
+
+// Files written to hidden temporaries in the target folder, renamed into place
+// by commit() in the order they were added; the destructor removes whatever
+// was not committed.
+class AtomicBatch {
+ public:
+  explicit AtomicBatch(fs::path dir) : dir_(std::move(dir)) {}
+  AtomicBatch(const AtomicBatch&) = delete;
+  AtomicBatch& operator=(const AtomicBatch&) = delete;
+  ~AtomicBatch() {
+    std::error_code ec;
+    for (const auto& [tmp, final_path] : files_) fs::remove(tmp, ec);
+  }
+
+  // A fresh temporary path for the final file `name` (in the same folder, so
+  // the rename is atomic).
+  fs::path add(const std::string& name) {
+    static std::atomic<unsigned> counter{0};
+    const fs::path tmp = dir_ / ("." + name + ".tmp-" + std::to_string(::getpid()) + "-" +
+                                 std::to_string(counter++));
+    files_.emplace_back(tmp, dir_ / name);
+    return tmp;
+  }
+
+  void commit() {
+    for (const auto& [tmp, final_path] : files_) sync_path(tmp);
+    for (const auto& [tmp, final_path] : files_) {
+      std::error_code ec;
+      fs::rename(tmp, final_path, ec);
+      if (ec)
+        throw std::runtime_error(final_path.string() + ": cannot rename the temporary " +
+                                 tmp.string() + " into place: " + ec.message());
+    }
+    files_.clear();
+    sync_path(dir_);
+  }
+
+ private:
+  // Flush a file or folder to disk, so that a crash after the rename cannot
+  // leave a complete name pointing at incomplete data. Best effort.
+  static void sync_path(const fs::path& p) {
+    const int fd = ::open(p.c_str(), O_RDONLY);
+    if (fd < 0) return;
+    ::fsync(fd);
+    ::close(fd);
+  }
+
+  fs::path dir_;
+  std::vector<std::pair<fs::path, fs::path>> files_;
+};
+
+void write_text(const fs::path& tmp, const fs::path& final_path, const std::string& text) {
+  std::ofstream out(tmp, std::ios::binary);
+  if (!out) throw std::runtime_error(final_path.string() + ": cannot open for writing");
+  out << text;
+  out.close();
+  if (!out) throw std::runtime_error(final_path.string() + ": write failed");
+}
+
+void write_image(const fs::path& tmp, const fs::path& final_path, const char* format,
+                 const OIIO::ImageSpec& spec, OIIO::TypeDesc type, const void* data) {
+  auto out = OIIO::ImageOutput::create(format);
+  if (!out)
+    throw std::runtime_error(final_path.string() + ": no " + format +
+                             " writer: " + OIIO::geterror());
+  if (!out->open(tmp.string(), spec))
+    throw std::runtime_error(final_path.string() + ": cannot open for writing: " +
+                             out->geterror());
+  if (!out->write_image(type, data))
+    throw std::runtime_error(final_path.string() + ": write failed: " + out->geterror());
+  if (!out->close())
+    throw std::runtime_error(final_path.string() + ": close failed: " + out->geterror());
+}
+
+// Interleaved RGB float32 texels of a term, zero outside the mask.
+std::vector<float> interleaved_texels(const FactorTerm& t) {
+  const int R = t.proj.res;
+  std::vector<float> px(size_t(R) * R * 3, 0.0f);
+  for (size_t k = 0; k < size_t(R) * R; ++k) {
+    if (!t.mask[k]) continue;
+    for (int c = 0; c < 3; ++c) px[3 * k + c] = t.texels[c][k];
+  }
+  return px;
+}
+
+double srgb_encode(double v) {
+  v = std::clamp(v, 0.0, 1.0);
+  return v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(v, 1.0 / 2.4) - 0.055;
+}
+
+// 8-bit sRGB preview (see export.h), size (R*block)^2.
+std::vector<uint8_t> preview_pixels(const FactorTerm& t, int& size) {
+  const int R = t.proj.res;
+  const int block = std::max(1, 256 / R);
+  size = R * block;
+  double mx = 0.0;
+  for (size_t k = 0; k < size_t(R) * R; ++k)
+    if (t.mask[k])
+      for (int c = 0; c < 3; ++c) mx = std::max(mx, std::exp(double(t.texels[c][k])));
+  // One colour per texel, then replicated into its block.
+  std::vector<std::array<uint8_t, 3>> colour(size_t(R) * R, {255, 255, 0});
+  for (size_t k = 0; k < size_t(R) * R; ++k)
+    if (t.mask[k])
+      for (int c = 0; c < 3; ++c) {
+        const double v = mx > 0.0 ? std::exp(double(t.texels[c][k])) / mx : 0.0;
+        colour[k][c] = uint8_t(std::lround(255.0 * srgb_encode(v)));
+      }
+  std::vector<uint8_t> px(size_t(size) * size * 3);
+  for (int y = 0; y < size; ++y)
+    for (int x = 0; x < size; ++x) {
+      const auto& col = colour[size_t(y / block) * R + x / block];
+      std::copy(col.begin(), col.end(), &px[(size_t(y) * size + x) * 3]);
+    }
+  return px;
+}
+
+void check_finite(const HomomorphicFactorization& f) {
+  const auto& terms = f.terms();
+  for (size_t k = 0; k < terms.size(); ++k) {
+    const FactorTerm& t = terms[k];
+    const std::string term = "export: term " + std::to_string(k);
+    if (!t.proj.P.allFinite()) throw std::invalid_argument(term + ": matrix has non-finite entries");
+    if ((t.proj.P.rowwise().lpNorm<1>().array() == 0.0).any())
+      throw std::invalid_argument(term + ": matrix has a zero row");
+    if (t.mask.size() != size_t(t.proj.res) * t.proj.res)
+      throw std::invalid_argument(term + ": mask has " + std::to_string(t.mask.size()) +
+                                  " entries, expected " +
+                                  std::to_string(size_t(t.proj.res) * t.proj.res));
+    for (int c = 0; c < 3; ++c)
+      for (size_t i = 0; i < t.texels[c].size(); ++i)
+        if (t.mask[i] && !std::isfinite(t.texels[c][i]))
+          throw std::invalid_argument(term + ": texel (" + std::to_string(i % t.proj.res) + ", " +
+                                      std::to_string(i / t.proj.res) + ") channel " +
+                                      kChannel[c] + " is " + std::to_string(t.texels[c][i]) +
+                                      ": refusing to export a non-finite texel");
+  }
+  if (!std::isfinite(f.eps())) throw std::invalid_argument("export: eps is not finite");
+}
+
+json mat_json(const Eigen::Matrix<double, 2, 4>& M) {
+  return {{M(0, 0), M(0, 1), M(0, 2), M(0, 3)}, {M(1, 0), M(1, 1), M(1, 2), M(1, 3)}};
+}
+
+Eigen::Matrix<double, 2, 4> texel_matrix(const Projection& p) {
+  const Eigen::Vector2d k = p.row_scale() * (0.5 * (p.res - 1));
+  return k.asDiagonal() * p.P;
+}
+
+// ---------------------------------------------------------------- reading
+
+// Field access with messages "FILE: field 'a.b[2]': expected X, found Y".
+class Sidecar {
+ public:
+  explicit Sidecar(std::string file) : file_(std::move(file)) {}
+
+  [[noreturn]] void fail_text(const std::string& field, const std::string& expected,
+                              const std::string& found) const {
+    throw std::invalid_argument(file_ + ": field '" + field + "': expected " + expected +
+                                ", found " + found);
+  }
+  [[noreturn]] void fail(const std::string& field, const std::string& expected,
+                         const json& found) const {
+    fail_text(field, expected, describe(found));
+  }
+
+  // Member `key` of object `obj` (named `where`, "" at the top level).
+  const json& member(const json& obj, const std::string& where, const std::string& key,
+                     const std::string& expected) const {
+    const std::string field = where.empty() ? key : where + "." + key;
+    auto it = obj.find(key);
+    if (it == obj.end()) fail_text(field, expected, "nothing (field missing)");
+    return *it;
+  }
+  static std::string field(const std::string& where, const std::string& key) {
+    return where.empty() ? key : where + "." + key;
+  }
+
+  std::string string(const json& obj, const std::string& where, const std::string& key) const {
+    const json& v = member(obj, where, key, "a string");
+    if (!v.is_string()) fail(field(where, key), "a string", v);
+    return v.get<std::string>();
+  }
+  bool boolean(const json& obj, const std::string& where, const std::string& key) const {
+    const json& v = member(obj, where, key, "true or false");
+    if (!v.is_boolean()) fail(field(where, key), "true or false", v);
+    return v.get<bool>();
+  }
+  long long integer(const json& obj, const std::string& where, const std::string& key, long long lo,
+                    long long hi) const {
+    const std::string expected =
+        "an integer in " + std::to_string(lo) + ".." + std::to_string(hi);
+    const json& v = member(obj, where, key, expected);
+    if (!v.is_number_integer()) fail(field(where, key), expected, v);
+    if (v.is_number_unsigned() && v.get<unsigned long long>() > static_cast<unsigned long long>(hi))
+      fail(field(where, key), expected, v);
+    const long long x = v.get<long long>();
+    if (x < lo || x > hi) fail(field(where, key), expected, v);
+    return x;
+  }
+  double number(const json& v, const std::string& field_name, const std::string& expected) const {
+    if (!v.is_number()) fail(field_name, expected, v);
+    const double x = v.get<double>();
+    if (!std::isfinite(x)) fail(field_name, expected, v);
+    return x;
+  }
+  // Array of exactly n elements.
+  const json& array(const json& v, const std::string& field_name, size_t n,
+                    const std::string& what) const {
+    const std::string expected = "an array of " + std::to_string(n) + " " + what;
+    if (!v.is_array()) fail(field_name, expected, v);
+    if (v.size() != n)
+      fail_text(field_name, expected, "an array of " + std::to_string(v.size()) + " elements");
+    return v;
+  }
+
+  const std::string& file() const { return file_; }
+
+ private:
+  static std::string describe(const json& v) {
+    if (v.is_null()) return "null";
+    std::string text = v.dump();
+    if (text.size() > 60) text = text.substr(0, 57) + "...";
+    return std::string(v.is_number() ? "number" : v.type_name()) + " " + text;
+  }
+  std::string file_;
+};
+
+// Reads a term's EXR into t.texels (planar), checking size, channels and values.
+void read_texture(const std::string& path, const std::string& field, FactorTerm& t) {
+  auto in = OIIO::ImageInput::open(path);
+  if (!in) {
+    std::string err = OIIO::geterror();
+    if (!fs::exists(path)) err = "file not found";
+    throw std::invalid_argument(path + " (" + field + "): cannot open texture: " + err);
+  }
+  const OIIO::ImageSpec& spec = in->spec();
+  const int R = t.proj.res;
+  if (spec.width != R || spec.height != R || spec.depth != 1)
+    throw std::invalid_argument(path + ": expected " + std::to_string(R) + "x" +
+                                std::to_string(R) + " texels (" + field +
+                                " resolution in the sidecar), found " +
+                                std::to_string(spec.width) + "x" + std::to_string(spec.height) +
+                                (spec.depth != 1 ? "x" + std::to_string(spec.depth) : ""));
+  if (spec.x != 0 || spec.y != 0)
+    throw std::invalid_argument(path + ": expected the data window to start at (0, 0), found (" +
+                                std::to_string(spec.x) + ", " + std::to_string(spec.y) + ")");
+  if (spec.nchannels != 3)
+    throw std::invalid_argument(path + ": expected 3 channels (R, G, B), found " +
+                                std::to_string(spec.nchannels));
+  std::vector<float> px(size_t(R) * R * 3);
+  if (!in->read_image(0, 0, 0, 3, OIIO::TypeDesc::FLOAT, px.data()))
+    throw std::invalid_argument(path + ": cannot read pixels: " + in->geterror());
+  in->close();
+  for (int c = 0; c < 3; ++c) t.texels[c].assign(size_t(R) * R, 0.0f);
+  for (size_t k = 0; k < size_t(R) * R; ++k)
+    for (int c = 0; c < 3; ++c) {
+      const float v = px[3 * k + c];
+      const std::string where = "texel (" + std::to_string(k % R) + ", " +
+                                std::to_string(k / R) + ") channel " + kChannel[c];
+      if (!std::isfinite(v))
+        throw std::invalid_argument(path + ": " + where + ": expected a finite value, found " +
+                                    std::to_string(v));
+      if (!t.mask[k] && v != 0.0f)
+        throw std::invalid_argument(path + ": " + where +
+                                    ": expected 0 outside the projection mask, found " +
+                                    std::to_string(v));
+      t.texels[c][k] = v;
+    }
+}
+
+}  // namespace
+
+ExportedFiles write_factorization(const HomomorphicFactorization& f, const std::string& dir,
+                                  const std::string& stem) {
+  if (stem.empty() || stem.find('/') != std::string::npos)
+    throw std::invalid_argument("export: stem must be a non-empty file name without '/', found \"" +
+                                stem + "\"");
+  check_finite(f);
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec || !fs::is_directory(dir))
+    throw std::runtime_error(dir + ": cannot create the export folder" +
+                             (ec ? ": " + ec.message() : std::string()));
+
+  const fs::path d(dir);
+  const auto& terms = f.terms();
+  ExportedFiles files;
+  files.sidecar = (d / (stem + ".json")).string();
+  files.glsl = (d / (stem + ".glsl")).string();
+  std::vector<std::string> tex_names, png_names;
+  for (size_t k = 0; k < terms.size(); ++k) {
+    tex_names.push_back(stem + "_term" + std::to_string(k) + ".exr");
+    png_names.push_back(stem + "_term" + std::to_string(k) + ".png");
+    files.textures.push_back((d / tex_names.back()).string());
+    files.previews.push_back((d / png_names.back()).string());
+  }
+
+  AtomicBatch batch(d);
+  for (size_t k = 0; k < terms.size(); ++k) {
+    const FactorTerm& t = terms[k];
+    const int R = t.proj.res;
+    {
+      OIIO::ImageSpec spec(R, R, 3, OIIO::TypeDesc::FLOAT);
+      spec.channelnames = {"R", "G", "B"};
+      spec.attribute("compression", "zip");
+      spec.attribute("ImageDescription", "brdf-factor log-space factor texture, term " +
+                                             std::to_string(k) + " of " + stem + ".json");
+      const std::vector<float> px = interleaved_texels(t);
+      write_image(batch.add(tex_names[k]), files.textures[k], "openexr", spec,
+                  OIIO::TypeDesc::FLOAT, px.data());
+    }
+    {
+      int size = 0;
+      const std::vector<uint8_t> px = preview_pixels(t, size);
+      OIIO::ImageSpec spec(size, size, 3, OIIO::TypeDesc::UINT8);
+      spec.attribute("oiio:ColorSpace", "sRGB");
+      write_image(batch.add(png_names[k]), files.previews[k], "png", spec, OIIO::TypeDesc::UINT8,
+                  px.data());
+    }
+  }
+
+  write_text(batch.add(stem + ".glsl"), files.glsl,
+             generate_glsl(f, tex_names, stem + ".json"));
+
+  json j = f.describe();
+  j["format"] = kFactorExportFormat;
+  j["format_version"] = kFactorExportFormatVersion;
+  j["glsl"] = stem + ".glsl";
+  j["combine"] =
+      "per RGB channel: f = A * exp(g) " + std::string(f.subtract_eps() ? "- eps * A" : "") +
+      ", clamped at 0, where g = sum over terms of the bilinear lookup of the term's texture at "
+      "s(pi(x)), plus a second lookup of the same texture at s(pi*(x)) (the conjugate "
+      "projection) for reciprocal terms; x = the point of (wi, wo) in the term's "
+      "parameterization; f = 0 if wi.z <= 0 or wo.z <= 0";
+  j["texture_layout"] =
+      "float32 EXR, channels R, G, B = log-space texels; pixel (x, y) = texel (i, j), index "
+      "j * resolution + i, centred at s = (i, j); scanline y = 0 first; texels outside the "
+      "projection mask are 0";
+  j["conventions"] =
+      "n = +z, t = +x; wi towards the light, wo towards the viewer, unit vectors; f in 1/sr, "
+      "linear RGB, no cosine; parabolic map p(w) = (w.x, w.y) / (1 + w.z); wiwo: x = (p(wi), "
+      "p(wo)); halfdiff: x = (p(h), p(d)), h = normalize(wi + wo), d = wi in the frame "
+      "(r, s, h), r = normalize(t - (t.h) h) (t = +y if that is shorter than 1e-12), s = h x r";
+  for (size_t k = 0; k < terms.size(); ++k) {
+    const FactorTerm& t = terms[k];
+    json& tj = j["terms"][k];
+    tj["texture"] = tex_names[k];
+    tj["preview"] = png_names[k];
+    tj["sampler"] = glsl_sampler_name(k);
+    tj["channels"] = {"R", "G", "B"};
+    tj["texel_matrix"] = mat_json(texel_matrix(t.proj));
+    tj["texel_offset"] = {0.5 * (t.proj.res - 1), 0.5 * (t.proj.res - 1)};
+    tj["texel_mapping"] =
+        "s = clamp(texel_matrix * x + texel_offset, 0, resolution - 1); bilinear lookup at s; on "
+        "a GPU, GL_LINEAR at uv = (s + 0.5) / resolution";
+    if (t.reciprocal) {
+      const Projection c = t.proj.conjugate();
+      tj["conjugate_matrix"] = mat_json(c.P);
+      tj["conjugate_texel_matrix"] = mat_json(texel_matrix(c));
+    }
+  }
+  write_text(batch.add(stem + ".json"), files.sidecar, j.dump(2) + "\n");
+
+  batch.commit();
+  return files;
+}
+
+std::shared_ptr<HomomorphicFactorization> load_factorization(const std::string& json_path) {
+  json j;
+  {
+    std::ifstream in(json_path, std::ios::binary);
+    if (!in) {
+      throw std::invalid_argument(json_path + ": cannot open factorization sidecar" +
+                                  (fs::exists(json_path) ? "" : ": file not found"));
+    }
+    try {
+      j = json::parse(in);
+    } catch (const json::parse_error& e) {
+      throw std::invalid_argument(json_path + ": invalid JSON: " + e.what());
+    }
+  }
+  const Sidecar s(json_path);
+  if (!j.is_object()) s.fail("(top level)", "a JSON object", j);
+
+  const std::string format = s.string(j, "", "format");
+  if (format != kFactorExportFormat)
+    s.fail_text("format", "\"" + std::string(kFactorExportFormat) + "\"", "\"" + format + "\"");
+  {
+    const std::string expected = std::to_string(kFactorExportFormatVersion) +
+                                 " (the version this build reads)";
+    const json& v = s.member(j, "", "format_version", expected);
+    if (!v.is_number_integer() || v.get<long long>() != kFactorExportFormatVersion)
+      s.fail("format_version", expected, v);
+  }
+  const std::string method = s.string(j, "", "method");
+
+  Rgb A;
+  {
+    const json& a = s.array(s.member(j, "", "A", "an array of 3 numbers"), "A", 3, "numbers");
+    for (int c = 0; c < 3; ++c) {
+      const std::string field = "A[" + std::to_string(c) + "]";
+      A[c] = s.number(a[c], field, "a finite number > 0");
+      if (!(A[c] > 0.0)) s.fail(field, "a finite number > 0", a[c]);
+    }
+  }
+  const double eps = s.number(s.member(j, "", "eps", "a number in (0, 1]"), "eps",
+                              "a number in (0, 1]");
+  if (!(eps > 0.0 && eps <= 1.0)) s.fail("eps", "a number in (0, 1]", j["eps"]);
+  const bool subtract_eps = s.boolean(j, "", "subtract_eps");
+
+  const json& tjs = s.member(j, "", "terms", "an array of terms");
+  if (!tjs.is_array()) s.fail("terms", "an array of terms", tjs);
+  const fs::path folder = fs::path(json_path).parent_path();
+  std::vector<FactorTerm> terms;
+  for (size_t k = 0; k < tjs.size(); ++k) {
+    const std::string where = "terms[" + std::to_string(k) + "]";
+    const json& tj = tjs[k];
+    if (!tj.is_object()) s.fail(where, "an object", tj);
+    FactorTerm t;
+    const std::string param = s.string(tj, where, "parameterization");
+    if (param == "wiwo") {
+      t.proj.param = Parameterization::WiWo;
+    } else if (param == "halfdiff") {
+      t.proj.param = Parameterization::HalfDiff;
+    } else {
+      s.fail_text(where + ".parameterization", "\"wiwo\" or \"halfdiff\"", "\"" + param + "\"");
+    }
+    t.proj.res = int(s.integer(tj, where, "resolution", 2, 1024));
+    {
+      const std::string field = where + ".matrix";
+      const json& m = s.array(s.member(tj, where, "matrix", "a 2x4 array of numbers"), field, 2,
+                              "rows of 4 numbers (a 2x4 matrix)");
+      for (int r = 0; r < 2; ++r) {
+        const std::string rf = field + "[" + std::to_string(r) + "]";
+        const json& row = s.array(m[r], rf, 4, "numbers (a 2x4 matrix)");
+        for (int c = 0; c < 4; ++c)
+          t.proj.P(r, c) = s.number(row[c], rf + "[" + std::to_string(c) + "]", "a finite number");
+        if (t.proj.P.row(r).lpNorm<1>() == 0.0)
+          s.fail(rf, "a row with a non-zero entry", row);
+      }
+    }
+    t.reciprocal = s.boolean(tj, where, "reciprocal");
+    if (tj.contains("quaternion_pair")) {
+      const std::string field = where + ".quaternion_pair";
+      const json& q = s.array(tj["quaternion_pair"], field, 8, "numbers (S then T, each [w, x, y, z])");
+      std::array<double, 8> qp{};
+      for (int i = 0; i < 8; ++i)
+        qp[i] = s.number(q[i], field + "[" + std::to_string(i) + "]", "a finite number");
+      t.rotation = qp;
+    }
+    t.mask = projection_mask(t.proj);
+    if (tj.contains("mask_texels")) {
+      const long long n = s.integer(tj, where, "mask_texels", 0, 1024 * 1024);
+      if (size_t(n) != t.mask_count())
+        s.fail(where + ".mask_texels",
+               std::to_string(t.mask_count()) + " (the projection mask of this matrix and resolution)",
+               tj["mask_texels"]);
+    }
+    const std::string tex = s.string(tj, where, "texture");
+    if (tex.empty()) s.fail_text(where + ".texture", "a file name", "\"\"");
+    read_texture((folder / tex).string(), where + ".texture", t);
+    terms.push_back(std::move(t));
+  }
+  return std::make_shared<HomomorphicFactorization>(std::move(terms), A, eps, subtract_eps, method);
+}
+
+void register_export_loader(Catalogue& cat) {
+  cat.add_loader(".json", [](const std::string& path, const ParamDict& options) -> BrdfPtr {
+    options.check_unused("factorization sidecar", {});
+    return load_factorization(path);
+  });
+}
+
+}  // namespace bf

@@ -1,0 +1,81 @@
+// Factor export (DESIGN.md §5): a HomomorphicFactorization written as float
+// EXR textures, PNG previews, a JSON sidecar and a generated GLSL function, and
+// read back from the sidecar so that the reloaded factorization evaluates
+// bit-identically to the one that was written.
+//
+// Files, for stem STEM in folder DIR (all written atomically: each to a hidden
+// temporary in DIR, renamed into place once every file is complete, the
+// sidecar last, so an interrupted export leaves either the old files or the
+// new ones, never a half file):
+//   STEM_termK.exr   term K's log-space texels, float32, channels R, G, B,
+//                    res x res; pixel (x, y) = texel (i, j) = (x, y), index
+//                    j*res + i; scanline y = 0 comes first. Texels outside the
+//                    projection mask are 0.
+//   STEM_termK.png   preview: exp of the log texels divided by their maximum
+//                    over the masked texels and channels, sRGB 8 bit, each
+//                    texel a block of max(1, 256/res) pixels; texels outside
+//                    the mask are flat yellow (255, 255, 0).
+//   STEM.glsl        vec3 brdf_factor_eval(vec3 wi, vec3 wo), see factor/glsl.h.
+//   STEM.json        the sidecar: HomomorphicFactorization::describe() plus
+//                    format, format_version, texture file names and the
+//                    texel-coordinate mapping per term (see write_factorization).
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "factor/homomorphic.h"
+
+namespace bf {
+
+class Catalogue;
+
+// Version of the sidecar layout written by write_factorization and the only one
+// load_factorization accepts. Bump when a field changes meaning.
+inline constexpr int kFactorExportFormatVersion = 1;
+// Value of the sidecar's "format" field.
+inline constexpr const char* kFactorExportFormat = "brdf-factor-factorization";
+
+// Paths of the files one export wrote (absolute or as given by dir).
+struct ExportedFiles {
+  std::string sidecar;                // DIR/STEM.json
+  std::string glsl;                   // DIR/STEM.glsl
+  std::vector<std::string> textures;  // DIR/STEM_termK.exr, one per term
+  std::vector<std::string> previews;  // DIR/STEM_termK.png, one per term
+};
+
+// Writes the export of `f` into `dir` (created if missing) with file names
+// starting with `stem` (non-empty, no '/'). Throws std::invalid_argument if the
+// factorization holds non-finite values (texels, matrix entries), naming term,
+// texel and channel; std::runtime_error naming the path if a file cannot be
+// written. On any error, no temporary is left behind and no final file has
+// been replaced.
+//
+// Sidecar fields (besides those of describe()):
+//   format ("brdf-factor-factorization"), format_version (1), glsl (file name),
+//   combine (how terms combine, in words), texture_layout, conventions;
+//   per term: texture, preview, sampler (GLSL uniform name), channels,
+//   texel_matrix (2x4) and texel_offset (2) with
+//     s = clamp(texel_matrix * x + texel_offset, 0, resolution - 1),
+//     texel_matrix row r = matrix row r * row_scale_r * (resolution - 1) / 2,
+//   uv ((s + 0.5) / resolution, the GL_LINEAR coordinate), and for reciprocal
+//   terms conjugate_matrix and conjugate_texel_matrix.
+ExportedFiles write_factorization(const HomomorphicFactorization& f, const std::string& dir,
+                                  const std::string& stem);
+
+// Reads an export back from its sidecar (texture paths relative to the
+// sidecar's folder). Validates the format and version, every field's presence,
+// type and range (matrix 2x4, finite, no zero row; resolution 2..1024; A finite
+// and > 0; eps in (0, 1]; quaternion_pair 8 finite numbers if present), and
+// each EXR (size equal to the resolution, 3 channels, finite texels, zero
+// outside the projection mask, mask size equal to mask_texels if given).
+// Throws std::invalid_argument with a message naming the file, the field, what
+// was expected and what was found.
+std::shared_ptr<HomomorphicFactorization> load_factorization(const std::string& json_path);
+
+// Registers the ".json" loader, so a sidecar path works wherever a BRDF spec is
+// accepted (`--brdf results/run/factors.json`). It takes no options.
+void register_export_loader(Catalogue& cat);
+
+}  // namespace bf

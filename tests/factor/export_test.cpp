@@ -1,0 +1,464 @@
+// Tests of the factor export: round trip through EXR + JSON sidecar, loader
+// validation messages, atomic writes, catalogue registration, and the
+// generated GLSL compiled by glslangValidator.
+#include <unistd.h>
+
+#include <OpenImageIO/imageio.h>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <random>
+#include <sstream>
+
+#include "brdfs/catalogue.h"
+#include "brdfs/directions.h"
+#include "factor/export.h"
+#include "factor/glsl.h"
+#include "test_common.h"
+
+using namespace bf;
+namespace fs = std::filesystem;
+using Catch::Matchers::Contains;
+using nlohmann::json;
+
+namespace {
+
+// A fresh folder under the system temp dir, removed with its contents at scope exit.
+struct TempDir {
+  fs::path path;
+  TempDir() {
+    static int counter = 0;
+    path = fs::temp_directory_path() /
+           ("bf-export-test-" + std::to_string(::getpid()) + "-" + std::to_string(counter++));
+    fs::remove_all(path);
+    fs::create_directories(path);
+  }
+  ~TempDir() {
+    std::error_code ec;
+    fs::remove_all(path, ec);
+  }
+  std::string operator/(const std::string& name) const { return (path / name).string(); }
+};
+
+Mat24 random_orthonormal(std::mt19937_64& rng) {
+  std::normal_distribution<double> N(0.0, 1.0);
+  Vec4 a, b;
+  for (int i = 0; i < 4; ++i) a[i] = N(rng), b[i] = N(rng);
+  a.normalize();
+  b -= b.dot(a) * a;
+  b.normalize();
+  Mat24 P;
+  P.row(0) = a.transpose();
+  P.row(1) = b.transpose();
+  return P;
+}
+
+// Smooth random log-space texels (a few low-frequency sinusoids), 0 outside the mask.
+FactorTerm make_term(const Projection& p, bool reciprocal, std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> U(-1.0, 1.0);
+  FactorTerm t;
+  t.proj = p;
+  t.reciprocal = reciprocal;
+  t.mask = projection_mask(p);
+  const int R = p.res;
+  for (int c = 0; c < 3; ++c) {
+    double a[3], fx[3], fy[3], ph[3];
+    for (int m = 0; m < 3; ++m) a[m] = 0.3 * U(rng), fx[m] = 3 * U(rng), fy[m] = 3 * U(rng),
+                                ph[m] = 3 * U(rng);
+    t.texels[c].assign(size_t(R) * R, 0.0f);
+    for (int j = 0; j < R; ++j)
+      for (int i = 0; i < R; ++i) {
+        if (!t.mask[j * R + i]) continue;
+        double v = -0.2 * c;
+        for (int m = 0; m < 3; ++m) v += a[m] * std::sin(fx[m] * i / R + fy[m] * j / R + ph[m]);
+        t.texels[c][j * R + i] = float(v);
+      }
+  }
+  return t;
+}
+
+// Three terms: a wiwo term with a random orthonormal projection (and a
+// quaternion pair), a reciprocal halfdiff term, a reciprocal wiwo term.
+HomomorphicFactorization make_factorization(bool subtract_eps = true) {
+  std::mt19937_64 rng(2024);
+  std::vector<FactorTerm> terms;
+  Projection p0;
+  p0.param = Parameterization::WiWo;
+  p0.P = random_orthonormal(rng);
+  p0.res = 16;
+  terms.push_back(make_term(p0, false, rng));
+  terms.back().rotation = std::array<double, 8>{0.5, 0.5, -0.5, 0.5, 0.8, 0.0, 0.6, 0.0};
+  Projection p1;
+  p1.param = Parameterization::HalfDiff;
+  p1.P = random_orthonormal(rng);
+  p1.res = 12;
+  terms.push_back(make_term(p1, true, rng));
+  terms.push_back(make_term(projection_first_pair(Parameterization::WiWo, 8), true, rng));
+  return HomomorphicFactorization(std::move(terms), Rgb(0.3, 0.5, 0.7), 1e-5, subtract_eps,
+                                  "fit");
+}
+
+Vec3 random_upper(std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> U(0.0, 1.0);
+  const double z = U(rng), phi = 2 * M_PI * U(rng);
+  return from_spherical(std::acos(std::max(z, 1e-6)), phi);
+}
+
+// 1000 random pairs plus n = h, grazing, wi = wo and near wi = -wo pairs.
+std::vector<std::pair<Vec3, Vec3>> direction_pairs() {
+  std::mt19937_64 rng(99);
+  std::vector<std::pair<Vec3, Vec3>> v;
+  for (int k = 0; k < 1000; ++k) v.push_back({random_upper(rng), random_upper(rng)});
+  for (double th : {0.0, 1e-7, 0.5, 1.3, M_PI / 2 - 1e-7}) {
+    v.push_back({from_spherical(th, 0.3), from_spherical(th, 0.3 + M_PI)});
+    v.push_back({from_spherical(th, 1.0), from_spherical(th, 1.0)});
+    v.push_back({from_spherical(th, 0.0), from_spherical(M_PI / 2 - 1e-6, M_PI)});
+  }
+  return v;
+}
+
+json read_json(const std::string& path) {
+  std::ifstream in(path);
+  return json::parse(in);
+}
+
+void write_json(const std::string& path, const json& j) {
+  std::ofstream out(path);
+  out << j.dump(2);
+}
+
+std::string read_text(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+// Exports the test factorization to a folder, lets `corrupt` edit the sidecar,
+// and returns the sidecar path.
+std::string corrupted_export(const TempDir& dir, const std::function<void(json&)>& corrupt) {
+  const HomomorphicFactorization f = make_factorization();
+  const ExportedFiles files = write_factorization(f, dir.path.string(), "factors");
+  json j = read_json(files.sidecar);
+  corrupt(j);
+  write_json(files.sidecar, j);
+  return files.sidecar;
+}
+
+void write_exr(const std::string& path, int w, int h, int channels, const std::vector<float>& px) {
+  auto out = OIIO::ImageOutput::create(path);
+  REQUIRE(out);
+  OIIO::ImageSpec spec(w, h, channels, OIIO::TypeDesc::FLOAT);
+  REQUIRE(out->open(path, spec));
+  REQUIRE(out->write_image(OIIO::TypeDesc::FLOAT, px.data()));
+  REQUIRE(out->close());
+}
+
+}  // namespace
+
+TEST_CASE("export: reload evaluates bit-identically to the in-memory factorization") {
+  for (bool subtract_eps : {true, false}) {
+    const HomomorphicFactorization f = make_factorization(subtract_eps);
+    TempDir dir;
+    const ExportedFiles files = write_factorization(f, dir.path.string(), "factors");
+    for (const std::string& p : files.textures) CHECK(fs::exists(p));
+    for (const std::string& p : files.previews) CHECK(fs::exists(p));
+    CHECK(fs::exists(files.glsl));
+    // No temporaries left behind.
+    for (const auto& e : fs::directory_iterator(dir.path))
+      CHECK(e.path().filename().string()[0] != '.');
+
+    const auto g = load_factorization(files.sidecar);
+    CHECK(g->storage_floats() == f.storage_floats());
+    CHECK(g->method() == f.method());
+    CHECK(g->subtract_eps() == f.subtract_eps());
+    CHECK(g->eps() == f.eps());
+    CHECK((g->A() == f.A()).all());
+    REQUIRE(g->terms().size() == f.terms().size());
+    for (size_t k = 0; k < f.terms().size(); ++k) {
+      const FactorTerm &a = f.terms()[k], &b = g->terms()[k];
+      CHECK(a.proj.param == b.proj.param);
+      CHECK(a.proj.res == b.proj.res);
+      CHECK(a.proj.P == b.proj.P);
+      CHECK(a.reciprocal == b.reciprocal);
+      CHECK(a.rotation == b.rotation);
+      CHECK(a.mask == b.mask);
+      for (int c = 0; c < 3; ++c) CHECK(a.texels[c] == b.texels[c]);
+    }
+
+    double max_rel = 0.0;
+    size_t identical = 0, n = 0;
+    for (const auto& [wi, wo] : direction_pairs()) {
+      const Rgb a = f.eval(wi, wo), b = g->eval(wi, wo);
+      INFO("wi = " << bf_test::str(wi) << ", wo = " << bf_test::str(wo));
+      REQUIRE(a.allFinite());
+      for (int c = 0; c < 3; ++c) {
+        const double rel = std::abs(a[c] - b[c]) / std::max(std::abs(a[c]), 1e-300);
+        max_rel = std::max(max_rel, a[c] == b[c] ? 0.0 : rel);
+        CHECK(rel <= 1e-6);
+        identical += a[c] == b[c];
+        ++n;
+      }
+    }
+    INFO("max relative difference " << max_rel);
+    CHECK(identical == n);
+  }
+}
+
+TEST_CASE("export: sidecar holds what a renderer needs") {
+  const HomomorphicFactorization f = make_factorization();
+  TempDir dir;
+  const ExportedFiles files = write_factorization(f, dir.path.string(), "factors");
+  const json j = read_json(files.sidecar);
+  CHECK(j.at("format") == kFactorExportFormat);
+  CHECK(j.at("format_version") == kFactorExportFormatVersion);
+  CHECK(j.at("glsl") == "factors.glsl");
+  CHECK(j.at("eps") == 1e-5);
+  CHECK(j.at("subtract_eps") == true);
+  CHECK(j.at("A").size() == 3);
+  CHECK(j.contains("combine"));
+  REQUIRE(j.at("terms").size() == 3);
+  const json& t0 = j.at("terms")[0];
+  CHECK(t0.at("texture") == "factors_term0.exr");
+  CHECK(t0.at("preview") == "factors_term0.png");
+  CHECK(t0.at("sampler") == "brdf_factor_tex0");
+  CHECK(t0.at("resolution") == 16);
+  CHECK(t0.at("quaternion_pair").size() == 8);
+  CHECK(t0.at("reciprocal") == false);
+  CHECK_FALSE(t0.contains("conjugate_matrix"));
+  CHECK(j.at("terms")[1].contains("conjugate_matrix"));
+  // texel_matrix * x + texel_offset reproduces Projection::texel_coords.
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> U(-1.0, 1.0);
+  for (size_t k = 0; k < 3; ++k) {
+    const json& tj = j.at("terms")[k];
+    for (int trial = 0; trial < 20; ++trial) {
+      const Vec4 x(U(rng), U(rng), U(rng), U(rng));
+      const Eigen::Vector2d s = f.terms()[k].proj.texel_coords(x);
+      for (int r = 0; r < 2; ++r) {
+        double v = tj.at("texel_offset")[r].get<double>();
+        for (int c = 0; c < 4; ++c) v += tj.at("texel_matrix")[r][c].get<double>() * x[c];
+        CHECK(v == Approx(s[r]).margin(1e-12));
+      }
+    }
+  }
+  // Preview: upscaled to 256 px, outside-mask texels yellow.
+  auto in = OIIO::ImageInput::open(files.previews[0]);
+  REQUIRE(in);
+  CHECK(in->spec().width == 256);
+  CHECK(in->spec().nchannels == 3);
+  std::vector<uint8_t> px(256 * 256 * 3);
+  REQUIRE(in->read_image(0, 0, 0, 3, OIIO::TypeDesc::UINT8, px.data()));
+  const FactorTerm& t = f.terms()[0];
+  for (int k = 0; k < 16 * 16; ++k) {
+    const int x = (k % 16) * 16 + 8, y = (k / 16) * 16 + 8;
+    const uint8_t* p = &px[(size_t(y) * 256 + x) * 3];
+    if (!t.mask[k]) CHECK((p[0] == 255 && p[1] == 255 && p[2] == 0));
+  }
+}
+
+TEST_CASE("export: the loader names the file, field, expectation and finding") {
+  SECTION("missing field") {
+    TempDir dir;
+    const std::string p = corrupted_export(dir, [](json& j) { j.erase("eps"); });
+    REQUIRE_THROWS_WITH(load_factorization(p),
+                        Contains(p) && Contains("field 'eps'") && Contains("(0, 1]") &&
+                            Contains("field missing"));
+  }
+  SECTION("missing term field") {
+    TempDir dir;
+    const std::string p = corrupted_export(dir, [](json& j) { j["terms"][2].erase("matrix"); });
+    REQUIRE_THROWS_WITH(load_factorization(p),
+                        Contains("field 'terms[2].matrix'") && Contains("field missing"));
+  }
+  SECTION("wrong type") {
+    TempDir dir;
+    const std::string p = corrupted_export(dir, [](json& j) { j["terms"][1]["resolution"] = "12"; });
+    REQUIRE_THROWS_WITH(load_factorization(p),
+                        Contains(p) && Contains("field 'terms[1].resolution'") &&
+                            Contains("expected an integer in 2..1024") &&
+                            Contains("found string \"12\""));
+  }
+  SECTION("boolean of the wrong type") {
+    TempDir dir;
+    const std::string p = corrupted_export(dir, [](json& j) { j["terms"][0]["reciprocal"] = 1; });
+    REQUIRE_THROWS_WITH(load_factorization(p), Contains("field 'terms[0].reciprocal'") &&
+                                                   Contains("expected true or false") &&
+                                                   Contains("found number 1"));
+  }
+  SECTION("resolution out of range") {
+    TempDir dir;
+    const std::string p = corrupted_export(dir, [](json& j) { j["terms"][0]["resolution"] = 4096; });
+    REQUIRE_THROWS_WITH(load_factorization(p), Contains("field 'terms[0].resolution'") &&
+                                                   Contains("found number 4096"));
+  }
+  SECTION("resolution differs from the EXR") {
+    TempDir dir;
+    const std::string p = corrupted_export(dir, [](json& j) {
+      j["terms"][0]["resolution"] = 8;
+      j["terms"][0].erase("mask_texels");
+    });
+    REQUIRE_THROWS_WITH(load_factorization(p), Contains("factors_term0.exr") &&
+                                                   Contains("expected 8x8 texels") &&
+                                                   Contains("found 16x16"));
+  }
+  SECTION("mask_texels inconsistent with matrix and resolution") {
+    TempDir dir;
+    const std::string p = corrupted_export(dir, [](json& j) { j["terms"][0]["resolution"] = 8; });
+    REQUIRE_THROWS_WITH(load_factorization(p), Contains("field 'terms[0].mask_texels'"));
+  }
+  SECTION("matrix of the wrong shape") {
+    TempDir dir;
+    const std::string p =
+        corrupted_export(dir, [](json& j) { j["terms"][1]["matrix"][0] = {1.0, 0.0, 0.0}; });
+    REQUIRE_THROWS_WITH(load_factorization(p), Contains("field 'terms[1].matrix[0]'") &&
+                                                   Contains("expected an array of 4") &&
+                                                   Contains("found an array of 3"));
+  }
+  SECTION("NaN in A (JSON has no NaN: it is written as null)") {
+    TempDir dir;
+    const std::string p =
+        corrupted_export(dir, [](json& j) { j["A"][1] = std::numeric_limits<double>::quiet_NaN(); });
+    REQUIRE_THROWS_WITH(load_factorization(p), Contains(p) && Contains("field 'A[1]'") &&
+                                                   Contains("expected a finite number > 0") &&
+                                                   Contains("found null"));
+  }
+  SECTION("literal NaN in the text is invalid JSON") {
+    TempDir dir;
+    const std::string p = corrupted_export(dir, [](json& j) {});
+    std::string text = read_text(p);
+    const size_t a = text.find("\"A\": [");
+    REQUIRE(a != std::string::npos);
+    text.insert(a + 6, "NaN, ");
+    std::ofstream(p) << text;
+    REQUIRE_THROWS_WITH(load_factorization(p), Contains(p) && Contains("invalid JSON"));
+  }
+  SECTION("A <= 0 and eps out of range") {
+    TempDir dir;
+    const std::string p = corrupted_export(dir, [](json& j) { j["A"][0] = 0.0; });
+    REQUIRE_THROWS_WITH(load_factorization(p), Contains("field 'A[0]'") && Contains("found number 0"));
+    TempDir dir2;
+    const std::string q = corrupted_export(dir2, [](json& j) { j["eps"] = 2.0; });
+    REQUIRE_THROWS_WITH(load_factorization(q), Contains("field 'eps'") && Contains("found number 2"));
+  }
+  SECTION("format and version") {
+    TempDir dir;
+    const std::string p = corrupted_export(dir, [](json& j) { j["format_version"] = 2; });
+    REQUIRE_THROWS_WITH(load_factorization(p), Contains("field 'format_version'") &&
+                                                   Contains("expected 1") && Contains("found number 2"));
+    TempDir dir2;
+    const std::string q = corrupted_export(dir2, [](json& j) { j.erase("format"); });
+    REQUIRE_THROWS_WITH(load_factorization(q), Contains("field 'format'") && Contains("field missing"));
+  }
+  SECTION("unknown parameterization") {
+    TempDir dir;
+    const std::string p =
+        corrupted_export(dir, [](json& j) { j["terms"][0]["parameterization"] = "wohi"; });
+    REQUIRE_THROWS_WITH(load_factorization(p), Contains("field 'terms[0].parameterization'") &&
+                                                   Contains("\"wiwo\" or \"halfdiff\"") &&
+                                                   Contains("\"wohi\""));
+  }
+  SECTION("missing EXR") {
+    TempDir dir;
+    const std::string p = corrupted_export(dir, [](json& j) {});
+    fs::remove(dir / "factors_term1.exr");
+    REQUIRE_THROWS_WITH(load_factorization(p), Contains(dir / "factors_term1.exr") &&
+                                                   Contains("terms[1].texture") &&
+                                                   Contains("file not found"));
+  }
+  SECTION("EXR with a NaN texel, a nonzero texel outside the mask, 1 channel") {
+    const HomomorphicFactorization f = make_factorization();
+    const FactorTerm& t = f.terms()[2];
+    const int R = t.proj.res;
+    size_t inside = 0, outside = 0;
+    for (size_t k = 0; k < t.mask.size(); ++k) (t.mask[k] ? inside : outside) = k;
+    std::vector<float> px(size_t(R) * R * 3, 0.0f);
+    TempDir dir;
+    const std::string p = corrupted_export(dir, [](json& j) {});
+    px[3 * inside + 1] = std::numeric_limits<float>::quiet_NaN();
+    write_exr(dir / "factors_term2.exr", R, R, 3, px);
+    REQUIRE_THROWS_WITH(load_factorization(p), Contains("factors_term2.exr") &&
+                                                   Contains("channel G") &&
+                                                   Contains("expected a finite value"));
+    if (outside != inside && !t.mask[outside]) {
+      px.assign(px.size(), 0.0f);
+      px[3 * outside] = 1.0f;
+      write_exr(dir / "factors_term2.exr", R, R, 3, px);
+      REQUIRE_THROWS_WITH(load_factorization(p), Contains("outside the projection mask"));
+    }
+    write_exr(dir / "factors_term2.exr", R, R, 1, std::vector<float>(size_t(R) * R, 0.0f));
+    REQUIRE_THROWS_WITH(load_factorization(p),
+                        Contains("expected 3 channels") && Contains("found 1"));
+  }
+  SECTION("missing sidecar") {
+    TempDir dir;
+    REQUIRE_THROWS_WITH(load_factorization(dir / "nope.json"),
+                        Contains("nope.json") && Contains("file not found"));
+  }
+}
+
+TEST_CASE("export: a non-finite texel is refused and no file is written") {
+  std::vector<FactorTerm> terms = make_factorization().terms();
+  size_t k = 0;
+  while (!terms[1].mask[k]) ++k;
+  terms[1].texels[0][k] = std::numeric_limits<float>::infinity();
+  const HomomorphicFactorization f(terms, Rgb(1, 1, 1), 1e-5, true, "fit");
+  TempDir dir;
+  REQUIRE_THROWS_WITH(write_factorization(f, dir.path.string(), "factors"),
+                      Contains("term 1") && Contains("channel R") && Contains("non-finite"));
+  CHECK(fs::is_empty(dir.path));
+}
+
+TEST_CASE("export: a failed write leaves the previous export in place") {
+  TempDir dir;
+  const HomomorphicFactorization f = make_factorization();
+  const ExportedFiles files = write_factorization(f, dir.path.string(), "factors");
+  const std::string before = read_text(files.sidecar);
+  // A folder where the GLSL file should go makes its rename fail after the
+  // textures were written to temporaries.
+  fs::remove(files.glsl);
+  fs::create_directories(files.glsl + "/blocker");
+  CHECK_THROWS_WITH(write_factorization(f, dir.path.string(), "factors"),
+                    Contains("factors.glsl"));
+  CHECK(read_text(files.sidecar) == before);
+  for (const auto& e : fs::directory_iterator(dir.path))
+    CHECK(e.path().filename().string()[0] != '.');
+}
+
+TEST_CASE("export: the catalogue loads a sidecar through the .json loader") {
+  TempDir dir;
+  const HomomorphicFactorization f = make_factorization();
+  const ExportedFiles files = write_factorization(f, dir.path.string(), "factors");
+  Catalogue cat;
+  register_export_loader(cat);
+  const BrdfPtr b = cat.make(files.sidecar);
+  const Vec3 wi = from_spherical(0.4, 0.2), wo = from_spherical(0.7, 2.5);
+  CHECK((b->eval(wi, wo) == f.eval(wi, wo)).all());
+  CHECK_THROWS_WITH(cat.make(files.sidecar + ":scale=2"), Contains("unknown parameter 'scale'"));
+}
+
+TEST_CASE("export: generated GLSL compiles with glslangValidator") {
+  if (std::system("command -v glslangValidator > /dev/null 2>&1") != 0) {
+    WARN("glslangValidator not found (Debian package glslang-tools): GLSL not compiled");
+    return;
+  }
+  TempDir dir;
+  const HomomorphicFactorization f = make_factorization();
+  const ExportedFiles files = write_factorization(f, dir.path.string(), "factors");
+  const std::string glsl = read_text(files.glsl);
+  CHECK_THAT(glsl, Contains("vec3 brdf_factor_eval(vec3 wi, vec3 wo)"));
+  for (const char* version : {"#version 330 core\n", "#version 450\n"})
+    for (const char* define : {"", "#define BRDF_FACTOR_EXACT_BILINEAR\n"}) {
+      const std::string shader = std::string(version) + define + glsl +
+                                 "\nin vec3 v_wi;\nin vec3 v_wo;\nlayout(location = 0) out vec4 "
+                                 "color;\nvoid main() {\n  color = "
+                                 "vec4(brdf_factor_eval(normalize(v_wi), normalize(v_wo)), "
+                                 "1.0);\n}\n";
+      const std::string frag = dir / "test.frag", log = dir / "glslang.log";
+      std::ofstream(frag) << shader;
+      const int rc = std::system(("glslangValidator " + frag + " > " + log + " 2>&1").c_str());
+      INFO(version << define << read_text(log));
+      CHECK(rc == 0);
+    }
+}
