@@ -1,14 +1,15 @@
 // Lambert: f = kd / pi (constant), the simplest catalogue model.
-#include <sstream>
-
 #include "brdfs/catalogue.h"
 #include "brdfs/models.h"
 
 namespace bf {
 
+void LambertParams::validate() const {
+  detail::require_nonneg("lambert", "kd", kd);
+}
+
 Lambert::Lambert(const LambertParams& p) : p_(p) {
-  if ((p.kd < 0.0).any() || !p.kd.isFinite().all())
-    throw std::invalid_argument("lambert: kd must be finite and >= 0");
+  p_.validate();
 }
 
 Rgb Lambert::eval(const Vec3& wi, const Vec3& wo) const {
@@ -17,19 +18,18 @@ Rgb Lambert::eval(const Vec3& wi, const Vec3& wo) const {
 }
 
 std::string Lambert::to_string() const {
-  std::ostringstream os;
-  os << "lambert(kd=" << p_.kd.transpose() << ")";
-  return os.str();
+  return "lambert(kd=" + detail::fmt(p_.kd) + ")";
 }
 
 void register_lambert(Catalogue& cat) {
+  const LambertParams def;
   cat.add_model({"lambert",
                  "f = kd / pi. Energy conserving for kd <= 1 (albedo = kd).",
-                 {{"kd", "0.5", "diffuse albedo, r/g/b or one number, >= 0"}},
+                 {{"kd", detail::fmt(def.kd), "diffuse albedo, r/g/b or one number, >= 0"}},
                  [](const ParamDict& d) -> BrdfPtr {
                    LambertParams p;
                    p.kd = d.get_rgb("kd", p.kd);
-                   return std::make_shared<Lambert>(p);
+                   return detail::make_checked<Lambert>(d, p);
                  }});
 }
 
