@@ -1,0 +1,181 @@
+// The SVD baseline (Kautz & McCool 1999): the BRDF tabulated as a matrix over
+// a parabolic texel grid of (wi, wo) or (h, d), truncated to rank K by SVD per
+// RGB channel (optionally in McCool's log space), evaluated anywhere by
+// bilinear lookups of the factor textures. Also the pieces the SH baselines
+// share: the parabolic texel grid and tolerance-driven selection of a size
+// knob (rank, order) with its time and error (DESIGN.md §6, §9).
+#pragma once
+
+#include <Eigen/Core>
+#include <array>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "brdfs/directions.h"
+#include "brdfs/sampleset.h"
+#include "factor/factorization.h"
+#include "factor/projection.h"
+#include "solvers/svd.h"
+
+namespace bf {
+
+// The res x res parabolic texel grid used by the SVD and SH-K baselines.
+// Texel (i, j), index j*res + i, sits at the parabolic point
+//   p = (-1 + 2 i/(res-1), -1 + 2 j/(res-1)),
+// so the grid's outer texels lie on the disk edge; the texel coordinates of a
+// point p are s = (p + 1)/2 * (res - 1), read with bilinear() of
+// factor/projection.h. Only "masked" texels are stored and computed: the
+// corners of every grid cell that meets the closed unit disk (what bilinear
+// lookups of points in the disk can read). A texel is evaluated at the
+// direction of its point pulled in to radius 1 - rim_inset when it lies
+// further out: texels on or outside the disk edge take the BRDF's value at
+// the grazing direction of the same azimuth (theta ~ 89.99 deg for the default
+// inset), a continuous extension; a direction exactly on the horizon would
+// read 0 from every BRDF.
+struct DiskGrid {
+  int res = 0;
+  std::vector<int> texels;  // masked texel indices, ascending
+  std::vector<int> slot;    // res*res entries: position in texels, or -1
+  // Throws std::invalid_argument unless 2 <= res <= 1024.
+  static DiskGrid make(int res);
+  Vec2 point(int texel) const;
+  // Unit direction (z > 0) at which texel `texel` is evaluated (see above).
+  Vec3 direction(int texel, double rim_inset) const;
+  // Texture coordinates of a parabolic point.
+  Eigen::Vector2d coords(const Vec2& p) const;
+  size_t count() const { return texels.size(); }
+};
+
+struct SvdOptions {
+  // Rows = first half of the 4D point, columns = second half: (p(wi), p(wo))
+  // for wiwo, (p(h), p(d)) for halfdiff (DESIGN.md §2).
+  Parameterization param = Parameterization::WiWo;
+  int res = 32;             // texture_size: res x res grid for rows and for columns, 2..256
+  int rank = 1;             // terms K >= 1 (capped at the matrix rank dimension)
+  bool log = false;         // decompose g = log((f + eps A)/A) instead of f
+  double eps = 1e-5;        // log-space bias (DESIGN.md §2), 0 < eps <= 1
+  bool subtract_eps = false;  // log reconstruction A exp(.) - eps A (else A exp(.)); Cole omits it
+  double rim_inset = 1e-4;  // DiskGrid: texels beyond radius 1 - rim_inset are pulled in; (0, 0.1]
+  bool float_textures = false;  // round factor textures to float (what an EXR export holds)
+  // Throws std::invalid_argument naming the field, its value and the rule.
+  void validate() const;
+};
+
+// The tabulated matrix the SVD decomposes, per RGB channel (rows x cols over
+// grid.texels), already log-transformed when log is set. Entry (r, c) is the
+// BRDF's own eval at the texel directions: a measured BRDF is resampled by its
+// own interpolation; pairs below the horizon hold 0 (log: log(eps)).
+struct SvdTable {
+  Parameterization param = Parameterization::WiWo;
+  DiskGrid grid;                      // rows and columns share it
+  std::array<Eigen::MatrixXd, 3> M;   // per channel, grid.count() x grid.count()
+  bool log = false;
+  double eps = 1e-5;
+  // Log mode: per-channel mean of f over the in-domain entries (both texel
+  // points inside the closed disk, wi and wo above the horizon); else 1.
+  Rgb A = Rgb::Ones();
+  double seconds = 0;                 // wall time of the tabulation
+};
+SvdTable tabulate_svd(const Brdf& brdf, const SvdOptions& opt);
+
+// f_c(wi, wo) = sum_k sigma_ck u_ck(s_row) v_ck(s_col)             (linear)
+// f_c(wi, wo) = A_c exp(sum_k sigma_ck u_ck(s_row) v_ck(s_col)) [- eps A_c]   (log)
+// with s_row, s_col the texture coordinates of the two halves of
+// to_point(param, wi, wo) and u, v read by bilinear interpolation; the result
+// is clamped at 0 (as a renderer would) and is 0 below the horizon.
+class SvdFactorization final : public Factorization {
+ public:
+  // svd[c]: decomposition of channel c of the table built with opt on grid;
+  // A: the table's A (log mode). seconds: wall time of tabulation + SVD.
+  SvdFactorization(const SvdOptions& opt, DiskGrid grid, Rgb A, std::array<TruncatedSvd, 3> svd,
+                   double seconds);
+
+  Rgb eval(const Vec3& wi, const Vec3& wo) const override;
+  // The model before the clamp at 0 (and before exp in log mode): the value
+  // the rank-K matrix holds at grid nodes.
+  Rgb eval_raw(const Vec3& wi, const Vec3& wo) const;
+  std::string name() const override { return "svd"; }
+  std::string to_string() const override;
+  bool isotropic() const override { return false; }
+  bool reciprocal() const override { return false; }
+  std::string method() const override { return "svd"; }
+  // K * (rows + cols) * 3 masked texels + 3K singular values (+ 3 A + 1 eps in log mode).
+  size_t storage_floats() const override;
+  nlohmann::json describe() const override;
+
+  int rank() const { return rank_; }
+  const SvdOptions& options() const { return opt_; }
+  const DiskGrid& grid() const { return grid_; }
+  const Rgb& A() const { return A_; }
+  // Factor vectors over grid().texels (unit norm), and sigma_ck.
+  const Eigen::MatrixXd& U(int c) const { return svd_[c].U; }
+  const Eigen::MatrixXd& V(int c) const { return svd_[c].V; }
+  double sigma(int c, int k) const { return svd_[c].sigma[k]; }
+  // All singular values of channel c (including the discarded ones).
+  const Eigen::VectorXd& singular_values(int c) const { return svd_[c].sigma; }
+  // Eckart-Young error of channel c: sqrt of the discarded sigma^2 (matrix space).
+  double discarded_norm(int c) const;
+  // Full res*res texture of term k, channel c (0 outside the mask): the row
+  // factor u_ck or the column factor v_ck.
+  std::vector<double> row_texture(int c, int k) const;
+  std::vector<double> col_texture(int c, int k) const;
+  // Negative texels over all stored u and v textures and channels: what an
+  // unsigned texture format cannot hold (a log-mode factor is combined through
+  // exp, so there negative texels are expected and harmless).
+  size_t negative_texels() const { return negative_texels_; }
+  // The rank-k prefix (k <= rank()): same decomposition, fewer terms.
+  std::shared_ptr<SvdFactorization> truncated(int k) const;
+  double seconds() const { return seconds_; }
+
+ private:
+  double term_sum(int c, const Bilinear& row, const Bilinear& col) const;
+  SvdOptions opt_;
+  DiskGrid grid_;
+  std::array<TruncatedSvd, 3> svd_;
+  int rank_;
+  Rgb A_;
+  size_t negative_texels_ = 0;
+  double seconds_ = 0;
+};
+
+// Tabulate, decompose, wrap. Throws std::invalid_argument from opt.validate(),
+// or when log mode meets a BRDF whose mean is 0 in a channel.
+std::shared_ptr<SvdFactorization> fit_svd(const Brdf& brdf, const SvdOptions& opt);
+// Decompose an existing table (rank and float_textures from opt).
+std::shared_ptr<SvdFactorization> fit_svd(const SvdTable& table, const SvdOptions& opt);
+
+// ---------------------------------------------------------------------------
+// Tolerance-driven size selection (DESIGN.md §9 "what a scene needs"), shared
+// by the SVD and SH baselines.
+
+// An error target: a metric of factor/metrics.h (metric_value names) and a value.
+struct Tolerance {
+  std::string metric = "cos_rmse";
+  double value = 0.0;  // > 0
+  // Throws std::invalid_argument for an unknown metric or value <= 0 / NaN.
+  void validate() const;
+};
+
+// What a selection chose, with its error and time (a row of a report).
+struct SizeChoice {
+  std::string method;   // "svd", "sh-k", "sh-r"
+  std::string knob;     // "terms" (SVD rank) or "order" (SH band limit F)
+  int value = 0;        // the chosen rank / order
+  std::string metric;   // tolerance metric
+  double error = 0;     // metric at the choice
+  bool reached = false; // error <= tolerance; false: nothing up to the cap reached it, value is the best tried
+  double seconds = 0;   // wall time: tabulation/projection + decompositions + scoring
+  std::vector<std::pair<int, double>> tried;  // (value, error) in the order scored
+  FactorizationPtr result;                    // the chosen approximation
+};
+
+// Smallest rank K <= max_rank whose SVD approximation scores <= tol on
+// `samples` (metrics of factor/metrics.h, log transform from the samples).
+// One tabulation and one SVD at max_rank; every K is a prefix of it.
+// base.rank is ignored.
+SizeChoice select_svd_rank(const Brdf& brdf, const SampleSet& samples, const SvdOptions& base,
+                           const Tolerance& tol, int max_rank);
+
+}  // namespace bf
