@@ -7,8 +7,8 @@
 
 namespace bf {
 
-const Catalogue& Catalogue::builtin() {
-  static const Catalogue cat = [] {
+Catalogue& Catalogue::global() {
+  static Catalogue cat = [] {
     Catalogue c;
     register_analytic_models(c);
     register_presets(c);

@@ -42,7 +42,11 @@ using FileLoader = std::function<BrdfPtr(const std::string& path, const ParamDic
 class Catalogue {
  public:
   // The catalogue with every built-in model, preset and loader registered.
-  static const Catalogue& builtin();
+  static const Catalogue& builtin() { return global(); }
+  // The same process-wide catalogue, for registering loaders that live in
+  // libraries brdfs/ must not depend on (the factorization .json loader of
+  // factor/export.h is added by the CLI and tests at start-up).
+  static Catalogue& global();
 
   void add_model(ModelInfo m);
   void add_preset(PresetInfo p);

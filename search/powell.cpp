@@ -1,0 +1,158 @@
+// Powell direction-set search over quaternion pairs (see powell.h).
+#include "search/powell.h"
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace bf {
+
+void PowellOptions::validate() const {
+  if (!(ftol > 0)) throw std::invalid_argument("ftol: expected > 0, found " + std::to_string(ftol));
+  if (!(line_tol > 0))
+    throw std::invalid_argument("line_tol: expected > 0, found " + std::to_string(line_tol));
+  if (!(initial_step > 0 && initial_step < 2 * M_PI))
+    throw std::invalid_argument("initial_step: expected in (0, 2 pi), found " +
+                                std::to_string(initial_step));
+  if (max_sweeps < 1)
+    throw std::invalid_argument("max_sweeps: expected >= 1, found " + std::to_string(max_sweeps));
+  if (max_evaluations < 10)
+    throw std::invalid_argument("max_evaluations: expected >= 10, found " +
+                                std::to_string(max_evaluations));
+}
+
+double line_minimize(const RotationObjective& f, const Rotation4& start, double f0,
+                     const LineDirection& dir, const PowellOptions& opt, double* best_t,
+                     int* evals) {
+  constexpr double kGold = 1.618033988749895;
+  constexpr double kR = 0.6180339887498949;  // 1 / golden ratio
+  const double kMaxT = 2 * M_PI;             // half the 4 pi period on either side
+  auto g = [&](double t) {
+    ++*evals;
+    return f(dir.at(start, t));
+  };
+  *best_t = 0.0;
+  if (dir.is_zero()) return f0;
+
+  // Bracket (a, b, c) with g(b) <= g(a), g(b) <= g(c), starting at t = 0.
+  double a = 0.0, fa = f0;
+  double b = opt.initial_step, fb = g(b);
+  if (fb > fa) {
+    const double bm = -opt.initial_step, fbm = g(bm);
+    if (fbm >= fa) {
+      // (bm, 0, b) already brackets a minimum at the start.
+      double lo = bm, hi = b, x1, x2, f1, f2;
+      x1 = hi - kR * (hi - lo);
+      x2 = lo + kR * (hi - lo);
+      f1 = g(x1);
+      f2 = g(x2);
+      double bt = 0.0, bv = f0;
+      while (hi - lo > opt.line_tol) {
+        if (f1 < f2) {
+          hi = x2; x2 = x1; f2 = f1; x1 = hi - kR * (hi - lo); f1 = g(x1);
+        } else {
+          lo = x1; x1 = x2; f1 = f2; x2 = lo + kR * (hi - lo); f2 = g(x2);
+        }
+      }
+      for (auto [x, v] : {std::pair{x1, f1}, std::pair{x2, f2}})
+        if (v < bv) { bv = v; bt = x; }
+      *best_t = bt;
+      return bv;
+    }
+    b = bm;
+    fb = fbm;
+  }
+  // Downhill from a to b: expand until the function rises or |t| hits the period bound.
+  double c = b + kGold * (b - a), fc;
+  if (std::abs(c) > kMaxT) c = std::copysign(kMaxT, c);
+  fc = g(c);
+  while (fc < fb && std::abs(c) < kMaxT) {
+    a = b; fa = fb;
+    b = c; fb = fc;
+    c = b + kGold * (b - a);
+    if (std::abs(c) > kMaxT) c = std::copysign(kMaxT, c);
+    fc = g(c);
+  }
+  if (fc < fb) {  // no rise before the bound: the bound is the best we have
+    *best_t = c;
+    return fc;
+  }
+  // Golden-section search inside [min(a,c), max(a,c)] around b.
+  double lo = std::min(a, c), hi = std::max(a, c);
+  double x1, x2, f1, f2;
+  if (hi - b > b - lo) {
+    x1 = b; f1 = fb; x2 = b + (1 - kR) * (hi - b); f2 = g(x2);
+  } else {
+    x2 = b; f2 = fb; x1 = b - (1 - kR) * (b - lo); f1 = g(x1);
+  }
+  while (hi - lo > opt.line_tol) {
+    if (f2 < f1) {
+      lo = x1; x1 = x2; f1 = f2; x2 = kR * x1 + (1 - kR) * hi; f2 = g(x2);
+    } else {
+      hi = x2; x2 = x1; f2 = f1; x1 = kR * x2 + (1 - kR) * lo; f1 = g(x1);
+    }
+  }
+  double bt = b, bv = fb;
+  if (f1 < bv) { bv = f1; bt = x1; }
+  if (f2 < bv) { bv = f2; bt = x2; }
+  if (f0 <= bv) { bt = 0.0; bv = f0; }
+  *best_t = bt;
+  return bv;
+}
+
+PowellResult powell_minimize(const RotationObjective& f, const Rotation4& start,
+                             const PowellOptions& opt) {
+  opt.validate();
+  PowellResult res;
+  std::vector<LineDirection> dirs;
+  for (const Rotation4& d : cole_basis_directions()) dirs.push_back(LineDirection::from(d));
+  Rotation4 p = start.normalized();
+  double fp = f(p);
+  res.evaluations = 1;
+  for (int sweep = 0; sweep < opt.max_sweeps && res.evaluations < opt.max_evaluations; ++sweep) {
+    res.sweeps = sweep + 1;
+    const Rotation4 p0 = p;
+    const double f0 = fp;
+    int ibig = 0;
+    double del = 0.0;
+    for (size_t i = 0; i < dirs.size(); ++i) {
+      double t;
+      const double fnew = line_minimize(f, p, fp, dirs[i], opt, &t, &res.evaluations);
+      if (fp - fnew > del) {
+        del = fp - fnew;
+        ibig = static_cast<int>(i);
+      }
+      if (fnew < fp) {
+        p = dirs[i].at(p, t).normalized();
+        fp = fnew;
+      }
+    }
+    if (2.0 * (f0 - fp) <= opt.ftol * (std::abs(f0) + std::abs(fp)) + 1e-20) break;
+    // Net direction of the sweep, D = R_f R_s^-1, and the extrapolated point D R_f.
+    const Rotation4 D = p.compose(p0.inverse()).normalized();
+    const Rotation4 pe = D.compose(p).normalized();
+    const double fe = f(pe);
+    ++res.evaluations;
+    if (fe < f0) {
+      const double tt = 2.0 * (f0 - 2.0 * fp + fe) * std::pow(f0 - fp - del, 2) -
+                        del * std::pow(f0 - fe, 2);
+      if (tt < 0.0) {
+        const LineDirection nd = LineDirection::from(D);
+        double t;
+        const double fnew = line_minimize(f, p, fp, nd, opt, &t, &res.evaluations);
+        if (fnew < fp) {
+          p = nd.at(p, t).normalized();
+          fp = fnew;
+        }
+        dirs[ibig] = dirs.back();
+        dirs.back() = nd;
+      }
+    }
+  }
+  res.best = p;
+  res.value = fp;
+  return res;
+}
+
+}  // namespace bf

@@ -1,0 +1,43 @@
+// Powell's direction-set minimization over 4D rotations (thesis 3.1.1-3.1.2):
+// lines R(t) = D^t R_s, golden-section line minimization with bracketing over
+// the periodic t, Cole's six initial directions, and the Numerical Recipes rule
+// for replacing a direction by the sweep's net direction.
+#pragma once
+
+#include <functional>
+
+#include "search/rotation4.h"
+
+namespace bf {
+
+using RotationObjective = std::function<double(const Rotation4&)>;
+
+struct PowellOptions {
+  // Stop when a full sweep improves less than this, relatively:
+  // 2 (f0 - fN) <= ftol (|f0| + |fN|) + 1e-20.
+  double ftol = 1e-3;
+  double line_tol = 0.02;     // golden section stops when the bracket is narrower (t, radians)
+  double initial_step = 0.3;  // first bracketing step along t
+  int max_sweeps = 30;        // >= 1
+  int max_evaluations = 5000; // objective evaluations per minimization, >= 10
+  void validate() const;      // throws std::invalid_argument naming the field
+};
+
+struct PowellResult {
+  Rotation4 best;
+  double value = 0;
+  int evaluations = 0;
+  int sweeps = 0;
+};
+
+// Minimizes f from start. Never returns a point worse than start.
+PowellResult powell_minimize(const RotationObjective& f, const Rotation4& start,
+                             const PowellOptions& opt);
+
+// One line minimization along dir from start (f(start) = f0 known).
+// Returns the best t found and its value; counts evaluations into *evals.
+double line_minimize(const RotationObjective& f, const Rotation4& start, double f0,
+                     const LineDirection& dir, const PowellOptions& opt, double* best_t,
+                     int* evals);
+
+}  // namespace bf
