@@ -5,12 +5,14 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <mutex>
 #include <sstream>
 #include <stdexcept>
 #include <tuple>
 
 #include "factor/metrics.h"
 #include "factor/projection.h"
+#include "solvers/parallel.h"
 #include "solvers/quadrature.h"
 #include "solvers/sh.h"
 
@@ -181,38 +183,49 @@ std::shared_ptr<ShkFactorization> fit_shk(const Brdf& brdf, const ShkOptions& op
   const Eigen::Index T = Eigen::Index(grid.count());
   std::array<Eigen::MatrixXd, 3> coeffs;
   for (auto& C : coeffs) C.resize(n, T);
-  // Views in chunks so the sample matrix stays small at high resolutions.
-  const Eigen::Index chunk = 128;
-  Eigen::MatrixXd Fm(Nq, 3 * chunk);
+  // Views in chunks (so the sample matrix stays small at high resolutions),
+  // chunks in parallel; each writes only its own coefficient columns.
+  const Eigen::Index chunk = 64;
+  const Eigen::Index n_chunks = (T + chunk - 1) / chunk;
   double min_product = std::numeric_limits<double>::infinity();
   double negatives = 0, checked = 0;
-  for (Eigen::Index t0v = 0; t0v < T; t0v += chunk) {
-    const Eigen::Index nb = std::min(chunk, T - t0v);
-    std::vector<uint8_t> inside(nb);
-    for (Eigen::Index b = 0; b < nb; ++b) {
-      const int texel = grid.texels[t0v + b];
-      inside[b] = grid.point(texel).norm() <= 1.0 + 1e-12;
-      const Vec3 v = grid.direction(texel, opt.rim_inset);
-      for (Eigen::Index k = 0; k < Nq; ++k) {
-        const Vec3& s = rule.dir[k];
-        const Rgb f = brdf.eval(s, v);
-        require_brdf_value(brdf, f, "sh-k");
-        for (int c = 0; c < 3; ++c) Fm(k, 3 * b + c) = f[c] * s.z();
+  std::mutex stats_mutex;
+  parallel_for(n_chunks, [&](int64_t k0, int64_t k1) {
+    Eigen::MatrixXd Fm(Nq, 3 * chunk);
+    double local_min = std::numeric_limits<double>::infinity(), local_neg = 0, local_checked = 0;
+    for (int64_t kc = k0; kc < k1; ++kc) {
+      const Eigen::Index t0v = Eigen::Index(kc) * chunk;
+      const Eigen::Index nb = std::min(chunk, T - t0v);
+      std::vector<uint8_t> inside(nb);
+      for (Eigen::Index b = 0; b < nb; ++b) {
+        const int texel = grid.texels[t0v + b];
+        inside[b] = grid.point(texel).norm() <= 1.0 + 1e-12;
+        const Vec3 v = grid.direction(texel, opt.rim_inset);
+        for (Eigen::Index k = 0; k < Nq; ++k) {
+          const Vec3& s = rule.dir[k];
+          const Rgb f = brdf.eval(s, v);
+          require_brdf_value(brdf, f, "sh-k");
+          for (int c = 0; c < 3; ++c) Fm(k, 3 * b + c) = f[c] * s.z();
+        }
+      }
+      const Eigen::MatrixXd C = Yw.transpose() * Fm.leftCols(3 * nb);  // n x 3nb
+      for (Eigen::Index b = 0; b < nb; ++b)
+        for (int c = 0; c < 3; ++c) coeffs[c].col(t0v + b) = C.col(3 * b + c);
+      // Ringing check at the quadrature nodes.
+      const Eigen::MatrixXd R = Y * C;  // Nq x 3nb
+      for (Eigen::Index b = 0; b < nb; ++b) {
+        if (!inside[b]) continue;
+        const auto block = R.middleCols(3 * b, 3);
+        local_min = std::min(local_min, block.minCoeff());
+        local_neg += double((block.array() < 0.0).count());
+        local_checked += double(block.size());
       }
     }
-    const Eigen::MatrixXd C = Yw.transpose() * Fm.leftCols(3 * nb);  // n x 3nb
-    for (Eigen::Index b = 0; b < nb; ++b)
-      for (int c = 0; c < 3; ++c) coeffs[c].col(t0v + b) = C.col(3 * b + c);
-    // Ringing check at the quadrature nodes.
-    const Eigen::MatrixXd R = Y * C;  // Nq x 3nb
-    for (Eigen::Index b = 0; b < nb; ++b) {
-      if (!inside[b]) continue;
-      const auto block = R.middleCols(3 * b, 3);
-      min_product = std::min(min_product, block.minCoeff());
-      negatives += double((block.array() < 0.0).count());
-      checked += double(block.size());
-    }
-  }
+    std::lock_guard<std::mutex> lock(stats_mutex);
+    min_product = std::min(min_product, local_min);
+    negatives += local_neg;
+    checked += local_checked;
+  });
   auto fit = std::make_shared<ShkFactorization>(opt, grid, std::move(coeffs), seconds_since(t0));
   fit->min_product = std::isfinite(min_product) ? min_product : 0.0;
   fit->negative_fraction = checked > 0 ? negatives / checked : 0.0;
@@ -240,7 +253,7 @@ SizeChoice select_shk_order(const Brdf& brdf, const SampleSet& samples, const Sh
     for (int k = scored + 1; k <= F; ++k) {
       auto fk = k == F ? fit : fit->truncated(k);
       const double e = metric_value(evaluate_metrics(*fk, samples, lt), tol.metric);
-      ch.tried.push_back({k, e});
+      ch.tried.push_back({k, -1, e});
       if (e < best) {
         best = e;
         ch.value = k;
@@ -363,33 +376,39 @@ ShrCoefficients shr_coefficients(const Brdf& brdf, const ShrOptions& opt) {
   std::array<Eigen::MatrixXd, 3> rq;
   for (auto& m : rq) m = Eigen::MatrixXd::Zero(ni, no * (P + 1));
   Rgb energy = Rgb::Zero();
-  std::vector<double> vals(3 * size_t(nphi));
-  for (int o = 0; o < no; ++o) {
-    const double cto = go.x[o];
-    const double half_c = std::sqrt(0.5 * (1.0 + cto)), half_s = std::sqrt(0.5 * (1.0 - cto));
-    for (int i = 0; i < ni; ++i) {
-      const double cti = gi.x[i], sti = std::sqrt(std::max(0.0, (1.0 - cti) * (1.0 + cti)));
-      for (int k = 0; k < nphi; ++k) {
-        Vec3 L, V;
-        reparam_to_local(cti, sti, cphi[k], sphi[k], half_c, half_s, L, V);
-        Rgb f = Rgb::Zero();
-        if (L.z() > 0.0) {
-          f = brdf.eval(L, V);
-          require_brdf_value(brdf, f, "sh-r");
-          f *= L.z();
+  std::mutex energy_mutex;
+  // theta_o nodes in parallel; each writes only its own columns of rq.
+  parallel_for(no, [&](int64_t o0, int64_t o1) {
+    std::vector<double> vals(3 * size_t(nphi));
+    Rgb local_energy = Rgb::Zero();
+    for (int o = int(o0); o < int(o1); ++o) {
+      const double cto = go.x[o];
+      const double half_c = std::sqrt(0.5 * (1.0 + cto)), half_s = std::sqrt(0.5 * (1.0 - cto));
+      for (int i = 0; i < ni; ++i) {
+        const double cti = gi.x[i], sti = std::sqrt(std::max(0.0, (1.0 - cti) * (1.0 + cti)));
+        for (int k = 0; k < nphi; ++k) {
+          Vec3 L, V;
+          reparam_to_local(cti, sti, cphi[k], sphi[k], half_c, half_s, L, V);
+          Rgb f = Rgb::Zero();
+          if (L.z() > 0.0) {
+            f = brdf.eval(L, V);
+            require_brdf_value(brdf, f, "sh-r");
+            f *= L.z();
+          }
+          local_energy += (2.0 * M_PI * gi.w[i] * go.w[o] * wphi) * f * f;
+          for (int c = 0; c < 3; ++c) vals[3 * k + c] = f[c];
         }
-        const double w = gi.w[i] * go.w[o] * wphi;
-        energy += 2.0 * M_PI * w * f * f;
-        for (int c = 0; c < 3; ++c) vals[3 * k + c] = f[c];
+        for (int c = 0; c < 3; ++c)
+          for (int q = 0; q <= P; ++q) {
+            double s = 0.0;
+            for (int k = 0; k < nphi; ++k) s += cosq(q, k) * vals[3 * k + c];
+            rq[c](i, o * (P + 1) + q) = s * wphi;
+          }
       }
-      for (int c = 0; c < 3; ++c)
-        for (int q = 0; q <= P; ++q) {
-          double s = 0.0;
-          for (int k = 0; k < nphi; ++k) s += cosq(q, k) * vals[3 * k + c];
-          rq[c](i, o * (P + 1) + q) = s * wphi;
-        }
     }
-  }
+    std::lock_guard<std::mutex> lock(energy_mutex);
+    energy += local_energy;
+  });
   // Steps 2 and 3: project on p_pq(cos to) and p_lq(cos ti).
   std::vector<double> col(std::max(F, P) + 1);
   Eigen::MatrixXd Po(no, (P + 1) * (P + 1));  // Po(o, p*(P+1)+q) = w_o p_pq(x_o)
@@ -557,6 +576,67 @@ std::shared_ptr<ShrFactorization> fit_shr(const Brdf& brdf, const ShrOptions& op
   }
   return std::make_shared<ShrFactorization>(all, F, P, opt.min_cos, opt.energy_eps,
                                             seconds_since(t0));
+}
+
+SizeChoice select_shr_orders_by_metric(const Brdf& brdf, const SampleSet& samples,
+                                       const ShrOptions& opt_in, const Tolerance& tol) {
+  tol.validate();
+  const auto t0 = std::chrono::steady_clock::now();
+  ShrOptions opt = opt_in;
+  opt.order = opt.view_order = -1;
+  const ShrCoefficients all = shr_coefficients(brdf, opt);
+  const LogTransform lt = LogTransform::of(samples);
+  SizeChoice ch;
+  ch.method = "sh-r";
+  ch.knob = "order";
+  ch.metric = tol.metric;
+  std::shared_ptr<ShrFactorization> best;
+  double best_e = std::numeric_limits<double>::infinity();
+  auto score = [&](int F, int P) {
+    auto f = std::make_shared<ShrFactorization>(all, F, P, opt.min_cos, 0.0, 0.0);
+    const double e = metric_value(evaluate_metrics(*f, samples, lt), tol.metric);
+    ch.tried.push_back({F, P, e});
+    if (e < best_e) {
+      best_e = e;
+      best = f;
+    }
+    return std::pair{e, f};
+  };
+  int P = -1;
+  for (int p = 0; p <= all.P; ++p) {
+    const auto [e, f] = score(all.F, p);
+    if (e <= tol.value) {
+      P = p;
+      ch.value = all.F;
+      ch.view_order = p;
+      ch.error = e;
+      ch.result = f;
+      ch.reached = true;
+      break;
+    }
+  }
+  if (P >= 0) {
+    int lo = 0, hi = all.F;  // (hi, P) reaches tol
+    while (lo < hi) {
+      const int mid = (lo + hi) / 2;
+      const auto [e, f] = score(mid, P);
+      if (e <= tol.value) {
+        hi = mid;
+        ch.value = mid;
+        ch.error = e;
+        ch.result = f;
+      } else {
+        lo = mid + 1;
+      }
+    }
+  } else {
+    ch.value = best->order();
+    ch.view_order = best->view_order();
+    ch.error = best_e;
+    ch.result = best;
+  }
+  ch.seconds = seconds_since(t0);
+  return ch;
 }
 
 // ================================================================ zonal (1D)

@@ -201,6 +201,15 @@ class ShrFactorization final : public Factorization {
 // Coefficients at the caps, orders by energy (or fixed), factorization.
 std::shared_ptr<ShrFactorization> fit_shr(const Brdf& brdf, const ShrOptions& opt);
 
+// Orders (F, P) by a metric tolerance on samples instead of the energy rule:
+// one projection at the caps (opt.max_order, e.g. the scene's lighting band
+// limit, and opt.max_view_order), then P minimal with (F_cap, P) scoring <= tol,
+// then F minimal at that P by bisection (assumes the error does not grow with
+// F). Not reached: (F_cap, best P). value = F, view_order = P.
+// opt.order/view_order/energy_eps are ignored.
+SizeChoice select_shr_orders_by_metric(const Brdf& brdf, const SampleSet& samples,
+                                       const ShrOptions& opt, const Tolerance& tol);
+
 // Radially symmetric ("1D") product functions rho_hat(u), u = cos of the angle
 // to the lobe axis (Phong: (s+1)/(2 pi) u^s about R): coefficients
 // rho_l = 2 pi * integral_{u_min}^{1} rho_hat(u) p_l0(u) du, l <= order, and the

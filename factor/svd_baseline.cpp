@@ -5,17 +5,28 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <mutex>
 #include <sstream>
 #include <stdexcept>
 
 #include "factor/metrics.h"
 #include "factor/projection.h"
+#include "solvers/parallel.h"
 
 namespace bf {
 
 namespace {
 double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// w with its elevation raised to at least z_min (azimuth kept; straight down
+// goes to azimuth 0), unit length.
+Vec3 lift_above_horizon(const Vec3& w, double z_min) {
+  if (w.z() >= z_min) return w;
+  const double t = std::hypot(w.x(), w.y()), s = std::sqrt(1.0 - z_min * z_min);
+  if (t < 1e-300) return Vec3(s, 0.0, z_min);
+  return Vec3(w.x() * s / t, w.y() * s / t, z_min);
 }
 }  // namespace
 
@@ -95,27 +106,43 @@ SvdTable tabulate_svd(const Brdf& brdf, const SvdOptions& opt) {
     dir[k] = t.grid.direction(t.grid.texels[k], opt.rim_inset);
     inside[k] = t.grid.point(t.grid.texels[k]).norm() <= 1.0 + 1e-12;
   }
+  // The lowest elevation a texel direction has (the pulled-in rim).
+  const double rr = 1.0 - opt.rim_inset, z_min = (1.0 - rr * rr) / (1.0 + rr * rr);
+  // Columns in parallel; each chunk keeps its own sums for A.
   Rgb sum = Rgb::Zero();
   double count = 0;
-  for (int c = 0; c < n; ++c)
-    for (int r = 0; r < n; ++r) {
-      Vec3 wi = dir[r], wo = dir[c];
-      if (opt.param == Parameterization::HalfDiff) half_diff_inverse(dir[r], dir[c], wi, wo);
-      Rgb f = Rgb::Zero();
-      if (wi.z() > 0.0 && wo.z() > 0.0) {
-        f = brdf.eval(wi, wo);
-        if (!f.isFinite().all() || (f < 0.0).any())
-          throw std::invalid_argument("svd: " + brdf.to_string() +
-                                      " returned a negative or non-finite value at texel pair (" +
-                                      std::to_string(t.grid.texels[r]) + ", " +
-                                      std::to_string(t.grid.texels[c]) + ")");
-        if (inside[r] && inside[c]) {
-          sum += f;
-          count += 1;
+  std::mutex sum_mutex;
+  parallel_for(n, [&](int64_t c0, int64_t c1) {
+    Rgb local_sum = Rgb::Zero();
+    double local_count = 0;
+    for (int c = int(c0); c < int(c1); ++c)
+      for (int r = 0; r < n; ++r) {
+        Vec3 wi = dir[r], wo = dir[c];
+        if (opt.param == Parameterization::HalfDiff) half_diff_inverse(dir[r], dir[c], wi, wo);
+        const bool valid = wi.z() > 0.0 && wo.z() > 0.0;
+        if (!valid && opt.extend_below_horizon) {
+          wi = lift_above_horizon(wi, z_min);
+          wo = lift_above_horizon(wo, z_min);
         }
+        Rgb f = Rgb::Zero();
+        if (wi.z() > 0.0 && wo.z() > 0.0) {
+          f = brdf.eval(wi, wo);
+          if (!f.isFinite().all() || (f < 0.0).any())
+            throw std::invalid_argument("svd: " + brdf.to_string() +
+                                        " returned a negative or non-finite value at texel pair (" +
+                                        std::to_string(t.grid.texels[r]) + ", " +
+                                        std::to_string(t.grid.texels[c]) + ")");
+          if (valid && inside[r] && inside[c]) {
+            local_sum += f;
+            local_count += 1;
+          }
+        }
+        for (int ch = 0; ch < 3; ++ch) t.M[ch](r, c) = f[ch];
       }
-      for (int ch = 0; ch < 3; ++ch) t.M[ch](r, c) = f[ch];
-    }
+    std::lock_guard<std::mutex> lock(sum_mutex);
+    sum += local_sum;
+    count += local_count;
+  });
   if (opt.log) {
     if (count == 0) throw std::invalid_argument("svd: no tabulated pair lies in the domain");
     t.A = sum / count;
@@ -250,6 +277,7 @@ nlohmann::json SvdFactorization::describe() const {
   j["texel_coords"] = "s = (p + 1) / 2 * (resolution - 1); texel (i, j) at s = (i, j), index j * resolution + i";
   j["texels_per_texture"] = grid_.count();
   j["rim_inset"] = opt_.rim_inset;
+  if (opt_.param == Parameterization::HalfDiff) j["extend_below_horizon"] = opt_.extend_below_horizon;
   j["rank"] = rank_;
   j["log"] = opt_.log;
   if (opt_.log) {
@@ -316,7 +344,7 @@ SizeChoice select_svd_rank(const Brdf& brdf, const SampleSet& samples, const Svd
   for (int k = 1; k <= full->rank(); ++k) {
     auto fk = full->truncated(k);
     const double e = metric_value(evaluate_metrics(*fk, samples, lt), tol.metric);
-    ch.tried.push_back({k, e});
+    ch.tried.push_back({k, -1, e});
     if (e < best || !ch.result) {
       best = e;
       ch.value = k;

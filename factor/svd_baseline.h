@@ -58,6 +58,12 @@ struct SvdOptions {
   double eps = 1e-5;        // log-space bias (DESIGN.md §2), 0 < eps <= 1
   bool subtract_eps = false;  // log reconstruction A exp(.) - eps A (else A exp(.)); Cole omits it
   double rim_inset = 1e-4;  // DiskGrid: texels beyond radius 1 - rim_inset are pulled in; (0, 0.1]
+  // halfdiff only: texel pairs (h, d) whose wi or wo falls below the horizon
+  // are no BRDF configuration; bilinear lookups near the horizon still read
+  // them. true: fill them with the BRDF at wi, wo lifted to the rim elevation
+  // (azimuth kept), a continuous extension; false: fill with 0, whose jump
+  // (a jump to log(eps) in log mode) the low-rank SVD then has to fit.
+  bool extend_below_horizon = true;
   bool float_textures = false;  // round factor textures to float (what an EXR export holds)
   // Throws std::invalid_argument naming the field, its value and the rule.
   void validate() const;
@@ -66,7 +72,8 @@ struct SvdOptions {
 // The tabulated matrix the SVD decomposes, per RGB channel (rows x cols over
 // grid.texels), already log-transformed when log is set. Entry (r, c) is the
 // BRDF's own eval at the texel directions: a measured BRDF is resampled by its
-// own interpolation; pairs below the horizon hold 0 (log: log(eps)).
+// own interpolation; halfdiff pairs below the horizon hold the lifted
+// extension or 0 (SvdOptions::extend_below_horizon).
 struct SvdTable {
   Parameterization param = Parameterization::WiWo;
   DiskGrid grid;                      // rows and columns share it
@@ -158,17 +165,25 @@ struct Tolerance {
   void validate() const;
 };
 
+// One scored candidate of a selection.
+struct SizeTrial {
+  int value = 0;        // rank K or order F
+  int view_order = -1;  // SH-R: view order P; -1 otherwise
+  double error = 0;     // the tolerance metric
+};
+
 // What a selection chose, with its error and time (a row of a report).
 struct SizeChoice {
   std::string method;   // "svd", "sh-k", "sh-r"
   std::string knob;     // "terms" (SVD rank) or "order" (SH band limit F)
   int value = 0;        // the chosen rank / order
+  int view_order = -1;  // SH-R: the chosen view order P; -1 otherwise
   std::string metric;   // tolerance metric
   double error = 0;     // metric at the choice
   bool reached = false; // error <= tolerance; false: nothing up to the cap reached it, value is the best tried
   double seconds = 0;   // wall time: tabulation/projection + decompositions + scoring
-  std::vector<std::pair<int, double>> tried;  // (value, error) in the order scored
-  FactorizationPtr result;                    // the chosen approximation
+  std::vector<SizeTrial> tried;  // in the order scored
+  FactorizationPtr result;       // the chosen approximation
 };
 
 // Smallest rank K <= max_rank whose SVD approximation scores <= tol on

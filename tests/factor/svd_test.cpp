@@ -236,3 +236,23 @@ TEST_CASE("svd: invalid options name the field") {
   REQUIRE_THROWS_WITH(select_svd_rank(brdf, sample_grid(brdf, 4), SvdOptions(), {"cos_rmse", 0.0}, 2),
                       Catch::Contains("value: expected a finite number > 0"));
 }
+
+TEST_CASE("svd: halfdiff pairs below the horizon are extended, not zeroed") {
+  // The zero fill puts a jump (log(eps) in log mode) inside the table that a
+  // low-rank SVD smears over valid texels; the lifted extension does not.
+  const GlossTest brdf(8.0);
+  const SampleSet s = sample_grid(brdf, 8);
+  const LogTransform lt = LogTransform::of(s);
+  double err[2];
+  for (bool ext : {false, true}) {
+    SvdOptions opt;
+    opt.param = Parameterization::HalfDiff;
+    opt.res = 12;
+    opt.rank = 3;
+    opt.log = true;
+    opt.extend_below_horizon = ext;
+    err[ext] = evaluate_metrics(*fit_svd(brdf, opt), s, lt).rel_mse;
+  }
+  INFO("rel_mse zero fill " << err[0] << ", extended " << err[1]);
+  CHECK(err[1] < 0.5 * err[0]);
+}

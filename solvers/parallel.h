@@ -1,0 +1,19 @@
+// A minimal fork-join loop over an index range on all cores (DESIGN.md §6:
+// "inside one process, use all cores"), for embarrassingly parallel loops such
+// as tabulating a BRDF. No pool is kept between calls.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+
+namespace bf {
+
+// Calls body(begin, end) on disjoint chunks covering [0, n), from up to
+// `threads` threads (0 = std::thread::hardware_concurrency()); the calling
+// thread takes part. Chunks are contiguous and in order per thread, so a body
+// writing only its own indices needs no locking. The first exception thrown
+// by any chunk is rethrown after all threads joined. n <= 0 does nothing.
+void parallel_for(int64_t n, const std::function<void(int64_t begin, int64_t end)>& body,
+                  int threads = 0);
+
+}  // namespace bf
