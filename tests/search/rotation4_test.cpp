@@ -59,12 +59,16 @@ TEST_CASE("rotation4: search lines D^t R have period 4 pi") {
   const auto basis = cole_basis_directions();
   std::vector<Rotation4> dirs(basis.begin(), basis.end());
   dirs.push_back(Rotation4{qexp(Quat(0, 0.3, 0.1, 0.0)), qexp(Quat(0, 0.0, -0.2, std::sqrt(0.06)))});
-  for (const Rotation4& d : dirs) {
-    const LineDirection line = LineDirection::from(d);
+  for (size_t di = 0; di < dirs.size(); ++di) {
+    const LineDirection line = LineDirection::from(dirs[di]);
     for (double t : {-1.0, 0.3, 2.0, 5.5}) {
       INFO("t = " << t);
       CHECK(line.at(start, t + 4 * M_PI).equal_up_to_sign(line.at(start, t), 1e-11));
-      CHECK_FALSE(line.at(start, t + 2 * M_PI).equal_up_to_sign(line.at(start, t), 1e-6));
+      // Basis directions move only S (or only T): at t + 2 pi that factor is
+      // negated alone, a different rotation. With equal angles in S and T both
+      // are negated, which is the same rotation (period 2 pi divides 4 pi).
+      if (di < 6)
+        CHECK_FALSE(line.at(start, t + 2 * M_PI).equal_up_to_sign(line.at(start, t), 1e-6));
     }
     CHECK(line.at(start, 0).equal_up_to_sign(start, 1e-15));
   }
