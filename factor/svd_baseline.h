@@ -53,7 +53,7 @@ struct SvdOptions {
   // for wiwo, (p(h), p(d)) for halfdiff (DESIGN.md §2).
   Parameterization param = Parameterization::WiWo;
   int res = 32;             // texture_size: res x res grid for rows and for columns, 2..256
-  int rank = 1;             // terms K >= 1 (capped at the matrix rank dimension)
+  int rank = 1;             // terms K >= 1 (capped at the number of masked texels)
   bool log = false;         // decompose g = log((f + eps A)/A) instead of f
   double eps = 1e-5;        // log-space bias (DESIGN.md §2), 0 < eps <= 1
   bool subtract_eps = false;  // log reconstruction A exp(.) - eps A (else A exp(.)); Cole omits it

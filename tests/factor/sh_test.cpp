@@ -422,3 +422,25 @@ TEST_CASE("sh-r: orders by a metric tolerance (P minimal at the cap, then F)") {
   CHECK_FALSE(none.reached);
   CHECK(none.value == 16);
 }
+
+TEST_CASE("sh-k and svd: float_textures rounds what is stored to float") {
+  const AnisoTest brdf;
+  ShkOptions opt;
+  opt.order = 3;
+  opt.view_res = 5;
+  opt.float_textures = true;
+  const auto f = fit_shk(brdf, opt);
+  for (int c = 0; c < 3; ++c)
+    CHECK((f->coefficients(c).cast<float>().cast<double>() - f->coefficients(c)).cwiseAbs().maxCoeff() == 0.0);
+  CHECK(f->describe()["float_textures"] == true);
+  SvdOptions so;
+  so.res = 6;
+  so.rank = 2;
+  so.float_textures = true;
+  const auto g = fit_svd(brdf, so);
+  for (int c = 0; c < 3; ++c) {
+    CHECK((g->U(c).cast<float>().cast<double>() - g->U(c)).cwiseAbs().maxCoeff() == 0.0);
+    CHECK(float(g->sigma(c, 1)) == g->sigma(c, 1));
+  }
+  CHECK(g->truncated(1)->describe()["float_textures"] == true);
+}
