@@ -10,5 +10,6 @@ namespace bf {
 void add_cmd_list(CLI::App& app);    // cmd_basic.cpp
 void add_cmd_eval(CLI::App& app);    // cmd_basic.cpp
 void add_cmd_sample(CLI::App& app);  // cmd_basic.cpp
+void add_cmd_export_merl(CLI::App& app);  // cmd_export_merl.cpp
 
 }  // namespace bf

@@ -14,6 +14,7 @@ int main(int argc, char** argv) {
   bf::add_cmd_list(app);
   bf::add_cmd_eval(app);
   bf::add_cmd_sample(app);
+  bf::add_cmd_export_merl(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
