@@ -306,7 +306,7 @@ TEST_CASE("sh-r: microfacet orders reproduce Ramamoorthi-Hanrahan Table 5 within
   for (int p = 0; p <= 3; ++p) CHECK(std::abs(c2.accuracy(40, p) - notes[p]) < 0.002);
 }
 
-TEST_CASE("sh-r: Table 5 at the notes' caps (60, 8) and a finer quadrature", "[slow]") {
+TEST_CASE("sh-r: Table 5 at the notes' caps F = 60 and P = 8 with a finer quadrature", "[slow]") {
   for (const Table5Row& row : kTable5) {
     const RhMicrofacet brdf(row.sigma);
     ShrOptions opt;  // caps F = 60, P = 8, auto quadrature 244 x 96 x 244
