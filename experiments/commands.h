@@ -11,5 +11,8 @@ void add_cmd_list(CLI::App& app);    // cmd_basic.cpp
 void add_cmd_eval(CLI::App& app);    // cmd_basic.cpp
 void add_cmd_sample(CLI::App& app);  // cmd_basic.cpp
 void add_cmd_export_merl(CLI::App& app);  // cmd_export_merl.cpp
+void add_cmd_bench(CLI::App& app);   // cmd_bench.cpp
+void add_cmd_run(CLI::App& app);     // cmd_run.cpp
+void add_cmd_merge(CLI::App& app);   // cmd_merge.cpp
 
 }  // namespace bf

@@ -4,7 +4,9 @@
 #include <exception>
 #include <iostream>
 
+#include "brdfs/catalogue.h"
 #include "experiments/commands.h"
+#include "factor/export.h"
 
 int main(int argc, char** argv) {
   CLI::App app{"brdf-factor: BRDF factorization toolkit (homomorphic fits, projection search, "
@@ -15,7 +17,11 @@ int main(int argc, char** argv) {
   bf::add_cmd_eval(app);
   bf::add_cmd_sample(app);
   bf::add_cmd_export_merl(app);
+  bf::add_cmd_bench(app);
+  bf::add_cmd_run(app);
+  bf::add_cmd_merge(app);
   try {
+    bf::register_export_loader(bf::Catalogue::global());
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
     return app.exit(e);

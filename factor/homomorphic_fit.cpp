@@ -5,6 +5,7 @@
 #include <Eigen/QR>
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -124,14 +125,22 @@ void laplacian_rows(const TermLayout& t, AddFn add_row) {
 }  // namespace
 
 JointSolution solve_joint(const FitData& d, const std::array<std::vector<double>, 3>& fixed_values,
-                          const std::vector<TermSpec>& joint, const FitOptions& opt) {
+                          const std::vector<TermSpec>& joint, const FitOptions& opt,
+                          bool exact_error) {
   opt.validate();
   if (joint.empty()) throw std::invalid_argument("fit: no terms to solve");
   const size_t N = d.size();
 
   // Layout: masks (thesis 3.2.4) extended by every texel a sample touches, so
-  // no sample ever reads a texel that is not an unknown.
+  // no sample ever reads a texel that is not an unknown. Each term has one or
+  // two "lookups" per sample (projection, and conjugate if reciprocal); a
+  // lookup is the lower-left texel of its bilinear cell and the fractions.
+  struct Lookups {
+    std::vector<int> cell;           // per sample: j * res + i
+    std::vector<double> fa, fb;      // per sample: fractions in [0, 1]
+  };
   std::vector<TermLayout> terms;
+  std::vector<std::array<Lookups, 2>> lookups;
   terms.reserve(joint.size());
   int M = 0;
   for (const TermSpec& s : joint) {
@@ -139,12 +148,23 @@ JointSolution solve_joint(const FitData& d, const std::array<std::vector<double>
     TermLayout t{FastProj(s.proj), FastProj(s.proj.conjugate()), s.reciprocal,
                  &d.points(s.proj.param), {}, projection_mask(s.proj), 0, 0};
     const std::vector<Vec4>& x = *t.x;
-    for (size_t k = 0; k < N; ++k) {
-      const Bilinear b = t.proj.at(x[k]);
-      for (int a = 0; a < 4; ++a) t.mask[b.idx[a]] = 1;
-      if (t.reciprocal) {
-        const Bilinear bc = t.conj.at(x[k]);
-        for (int a = 0; a < 4; ++a) t.mask[bc.idx[a]] = 1;
+    std::array<Lookups, 2> lk;
+    const int R = s.proj.res;
+    for (int h = 0; h < (t.reciprocal ? 2 : 1); ++h) {
+      const FastProj& fp = h == 0 ? t.proj : t.conj;
+      Lookups& L = lk[h];
+      L.cell.resize(N);
+      L.fa.resize(N);
+      L.fb.resize(N);
+      for (size_t k = 0; k < N; ++k) {
+        const double u = std::clamp(fp.M.row(0).dot(x[k]) + fp.off, 0.0, double(R - 1));
+        const double v = std::clamp(fp.M.row(1).dot(x[k]) + fp.off, 0.0, double(R - 1));
+        const int i = std::min(static_cast<int>(u), R - 2), j = std::min(static_cast<int>(v), R - 2);
+        const int c = j * R + i;
+        L.cell[k] = c;
+        L.fa[k] = u - i;
+        L.fb[k] = v - j;
+        t.mask[c] = t.mask[c + 1] = t.mask[c + R] = t.mask[c + R + 1] = 1;
       }
     }
     t.unk.assign(t.mask.size(), -1);
@@ -153,24 +173,28 @@ JointSolution solve_joint(const FitData& d, const std::array<std::vector<double>
       if (t.mask[i]) t.unk[i] = M++;
     t.count = M - t.first;
     terms.push_back(std::move(t));
+    lookups.push_back(std::move(lk));
   }
 
   // Per-sample stencils: up to 8 entries per term.
   const int maxL = 8 * static_cast<int>(terms.size());
   auto stencil = [&](size_t k, int* idx, double* val) {
     int L = 0;
-    for (const TermLayout& t : terms) {
-      const Bilinear b = t.proj.at((*t.x)[k]);
-      for (int a = 0; a < 4; ++a) {
-        idx[L] = t.unk[b.idx[a]];
-        val[L++] = b.w[a];
-      }
-      if (t.reciprocal) {
-        const Bilinear bc = t.conj.at((*t.x)[k]);
-        for (int a = 0; a < 4; ++a) {
-          idx[L] = t.unk[bc.idx[a]];
-          val[L++] = bc.w[a];
-        }
+    for (size_t ti = 0; ti < terms.size(); ++ti) {
+      const TermLayout& t = terms[ti];
+      const int R = t.proj.res;
+      for (int h = 0; h < (t.reciprocal ? 2 : 1); ++h) {
+        const Lookups& lk = lookups[ti][h];
+        const int c = lk.cell[k];
+        const double a = lk.fa[k], b = lk.fb[k];
+        idx[L] = t.unk[c];
+        val[L++] = (1 - a) * (1 - b);
+        idx[L] = t.unk[c + 1];
+        val[L++] = a * (1 - b);
+        idx[L] = t.unk[c + R];
+        val[L++] = (1 - a) * b;
+        idx[L] = t.unk[c + R + 1];
+        val[L++] = a * b;
       }
     }
     return L;
@@ -178,6 +202,7 @@ JointSolution solve_joint(const FitData& d, const std::array<std::vector<double>
 
   const double mu = opt.smoothing * d.W / std::max(M, 1);
   Eigen::MatrixXd Y(M, 3);  // solution, one column per channel
+  double quad_rel_mse = -1;  // set by the dense path when !exact_error
   std::vector<int> idx(maxL);
   std::vector<double> val(maxL);
 
@@ -231,41 +256,145 @@ JointSolution solve_joint(const FitData& d, const std::array<std::vector<double>
                                std::to_string(M) + " unknowns)");
     Y = llt.solve(rhs);
   } else if (solver == FitOptions::Solver::Dense) {
+    // Fast dense assembly. A lookup's 4x4 self-product only touches the texels
+    // of its bilinear cell: accumulate it (10 sums, plus 4x3 right-hand side
+    // sums) per (term, cell) in small arrays that stay in cache, and scatter
+    // them once. Products of two different lookups (different terms, or a
+    // reciprocal term's projection and conjugate) go straight into the lower
+    // triangle of A (column-major, 4 columns x 4 rows each).
     Eigen::MatrixXd A = Eigen::MatrixXd::Zero(M, M);
     Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(M, 3);
     double* Ad = A.data();
+    const size_t MM = static_cast<size_t>(M);
+    struct CellAcc {
+      double q[10];  // (0,0) (1,0) (2,0) (3,0) (1,1) (2,1) (3,1) (2,2) (3,2) (3,3)
+      double r[4][3];
+    };
+    std::vector<std::vector<CellAcc>> cells(terms.size());
+    for (size_t ti = 0; ti < terms.size(); ++ti)
+      cells[ti].assign(size_t(terms[ti].proj.res) * terms[ti].proj.res, CellAcc{});
+    // Flattened lookup list: (term, half) pairs in order.
+    std::vector<std::pair<int, int>> subs;
+    for (size_t ti = 0; ti < terms.size(); ++ti)
+      for (int h = 0; h < (terms[ti].reciprocal ? 2 : 1); ++h) subs.emplace_back(int(ti), h);
+    const int S = static_cast<int>(subs.size());
+    std::vector<int> sidx(4 * S);
+    std::vector<double> sw(4 * S);
+    double sum_wr2[3] = {0, 0, 0};
     for (size_t k = 0; k < N; ++k) {
-      const int L = stencil(k, idx.data(), val.data());
       const double w = d.w[k];
-      const double r0 = d.g[0][k] - fixed_values[0][k];
-      const double r1 = d.g[1][k] - fixed_values[1][k];
-      const double r2 = d.g[2][k] - fixed_values[2][k];
-      for (int a = 0; a < L; ++a) {
-        const double wa = w * val[a];
-        const int ia = idx[a];
-        double* col = Ad + static_cast<size_t>(ia) * M;
-        for (int b = 0; b < L; ++b) col[idx[b]] += wa * val[b];
-        rhs(ia, 0) += wa * r0;
-        rhs(ia, 1) += wa * r1;
-        rhs(ia, 2) += wa * r2;
+      const double r[3] = {d.g[0][k] - fixed_values[0][k], d.g[1][k] - fixed_values[1][k],
+                           d.g[2][k] - fixed_values[2][k]};
+      for (int c = 0; c < 3; ++c) sum_wr2[c] += w * r[c] * r[c];
+      for (int p = 0; p < S; ++p) {
+        const int ti = subs[p].first;
+        const Lookups& lk = lookups[ti][subs[p].second];
+        const int cell = lk.cell[k];
+        const double fa = lk.fa[k], fb = lk.fb[k];
+        const double b0 = (1 - fa) * (1 - fb), b1 = fa * (1 - fb), b2 = (1 - fa) * fb, b3 = fa * fb;
+        CellAcc& acc = cells[ti][cell];
+        const double wb0 = w * b0, wb1 = w * b1, wb2 = w * b2, wb3 = w * b3;
+        acc.q[0] += wb0 * b0; acc.q[1] += wb1 * b0; acc.q[2] += wb2 * b0; acc.q[3] += wb3 * b0;
+        acc.q[4] += wb1 * b1; acc.q[5] += wb2 * b1; acc.q[6] += wb3 * b1;
+        acc.q[7] += wb2 * b2; acc.q[8] += wb3 * b2; acc.q[9] += wb3 * b3;
+        for (int c = 0; c < 3; ++c) {
+          acc.r[0][c] += wb0 * r[c]; acc.r[1][c] += wb1 * r[c];
+          acc.r[2][c] += wb2 * r[c]; acc.r[3][c] += wb3 * r[c];
+        }
+        if (S > 1) {
+          const int R = terms[ti].proj.res;
+          const std::vector<int>& unk = terms[ti].unk;
+          sidx[4 * p] = unk[cell]; sidx[4 * p + 1] = unk[cell + 1];
+          sidx[4 * p + 2] = unk[cell + R]; sidx[4 * p + 3] = unk[cell + R + 1];
+          sw[4 * p] = b0; sw[4 * p + 1] = b1; sw[4 * p + 2] = b2; sw[4 * p + 3] = b3;
+        }
+      }
+      // Cross products of different lookups: q later than p, so for different
+      // terms idx_q > idx_p (lower triangle). Same-term pairs are folded below.
+      for (int p = 0; p < S; ++p)
+        for (int q = p + 1; q < S; ++q)
+          for (int a2 = 0; a2 < 4; ++a2) {
+            double* col = Ad + static_cast<size_t>(sidx[4 * p + a2]) * MM;
+            const double wa = w * sw[4 * p + a2];
+            col[sidx[4 * q]] += wa * sw[4 * q];
+            col[sidx[4 * q + 1]] += wa * sw[4 * q + 1];
+            col[sidx[4 * q + 2]] += wa * sw[4 * q + 2];
+            col[sidx[4 * q + 3]] += wa * sw[4 * q + 3];
+          }
+    }
+    // Fold reciprocal terms' upper-triangle entries into the lower triangle.
+    // Each cross product s_p s_q^T was added once; the symmetric pair
+    // s_p s_q^T + s_q s_p^T needs its diagonal twice. (So far only these
+    // same-term cross products have touched A's diagonal.)
+    for (const TermLayout& t : terms) {
+      if (!t.reciprocal) continue;
+      for (int j = t.first; j < t.first + t.count; ++j) {
+        A(j, j) *= 2.0;
+        for (int i = t.first; i < j; ++i) {
+          A(j, i) += A(i, j);
+          A(i, j) = 0.0;
+        }
       }
     }
+    // Scatter the per-cell sums into the lower triangle and the right-hand side.
+    for (size_t ti = 0; ti < terms.size(); ++ti) {
+      const TermLayout& t = terms[ti];
+      const int R = t.proj.res;
+      for (size_t cell = 0; cell < cells[ti].size(); ++cell) {
+        const CellAcc& acc = cells[ti][cell];
+        if (acc.q[0] == 0 && acc.q[4] == 0 && acc.q[7] == 0 && acc.q[9] == 0) continue;
+        const int id[4] = {t.unk[cell], t.unk[cell + 1], t.unk[cell + R], t.unk[cell + R + 1]};
+        const int pairs[10][2] = {{0, 0}, {1, 0}, {2, 0}, {3, 0}, {1, 1},
+                                  {2, 1}, {3, 1}, {2, 2}, {3, 2}, {3, 3}};
+        for (int e = 0; e < 10; ++e) {
+          const int i = id[pairs[e][0]], j = id[pairs[e][1]];
+          A(std::max(i, j), std::min(i, j)) += acc.q[e];
+        }
+        for (int v = 0; v < 4; ++v)
+          for (int c = 0; c < 3; ++c) rhs(id[v], c) += acc.r[v][c];
+      }
+    }
+    double reg_diag = 0;  // Laplacian, gauge and ridge go into A; remember them for the objective
     for (const TermLayout& t : terms)
       laplacian_rows(t, [&](const int* li, const double* lv, int n) {
-        for (int a = 0; a < n; ++a)
-          for (int b = 0; b < n; ++b) A(li[a], li[b]) += mu * lv[a] * lv[b];
+        for (int a2 = 0; a2 < n; ++a2)
+          for (int b2 = 0; b2 < n; ++b2)
+            if (li[a2] >= li[b2]) A(li[a2], li[b2]) += mu * lv[a2] * lv[b2];
       });
     const double mean_diag = A.diagonal().sum() / std::max(M, 1);
     for (size_t t = 1; t < terms.size(); ++t) {
       const double gamma = mean_diag / terms[t].count;
-      A.block(terms[t].first, terms[t].first, terms[t].count, terms[t].count).array() += gamma;
+      A.block(terms[t].first, terms[t].first, terms[t].count, terms[t].count)
+          .triangularView<Eigen::Lower>() += Eigen::MatrixXd::Constant(terms[t].count, terms[t].count, gamma);
     }
-    A.diagonal().array() += 1e-12 * mean_diag + std::numeric_limits<double>::min();
-    Eigen::LLT<Eigen::MatrixXd, Eigen::Lower> llt(A);
+    reg_diag = 1e-12 * mean_diag + std::numeric_limits<double>::min();
+    A.diagonal().array() += reg_diag;
+    Eigen::LLT<Eigen::Ref<Eigen::MatrixXd>, Eigen::Lower> llt(A);  // in place
     if (llt.info() != Eigen::Success)
       throw std::runtime_error("fit: the normal matrix is not positive definite (" +
                                std::to_string(M) + " unknowns)");
     Y = llt.solve(rhs);
+    if (!exact_error) {
+      // At the solution A y = rhs, so the data residual is
+      // sum w r^2 - y.rhs - (regularization quadratic form at y).
+      double se = 0;
+      for (int c = 0; c < 3; ++c) {
+        double reg = reg_diag * Y.col(c).squaredNorm();
+        for (const TermLayout& t : terms) {
+          laplacian_rows(t, [&](const int* li, const double* lv, int n) {
+            double v = 0;
+            for (int a2 = 0; a2 < n; ++a2) v += lv[a2] * Y(li[a2], c);
+            reg += mu * v * v;
+          });
+        }
+        for (size_t t = 1; t < terms.size(); ++t) {
+          const double sum = Y.col(c).segment(terms[t].first, terms[t].count).sum();
+          reg += mean_diag / terms[t].count * sum * sum;
+        }
+        se += sum_wr2[c] - Y.col(c).dot(rhs.col(c)) - reg;
+      }
+      quad_rel_mse = std::max(0.0, se) / (3.0 * d.W);
+    }
   } else {
     // Reference path: form B (data rows, Laplacian rows, gauge rows) densely and
     // solve the least-squares problem by Householder QR, without normal equations.
@@ -300,17 +429,21 @@ JointSolution solve_joint(const FitData& d, const std::array<std::vector<double>
   // Residual: rel_mse of fixed + joint terms, with the reconstruction's clamping.
   JointSolution sol;
   sol.unknowns = static_cast<size_t>(M);
-  double se = 0;
-  for (size_t k = 0; k < N; ++k) {
-    const int L = stencil(k, idx.data(), val.data());
-    for (int c = 0; c < 3; ++c) {
-      double s = fixed_values[c][k];
-      for (int a = 0; a < L; ++a) s += val[a] * Y(idx[a], c);
-      const double e = model_log_value(s, opt) - d.g[c][k];
-      se += d.w[k] * e * e;
+  if (!exact_error && quad_rel_mse >= 0) {
+    sol.rel_mse = quad_rel_mse;
+  } else {
+    double se = 0;
+    for (size_t k = 0; k < N; ++k) {
+      const int L = stencil(k, idx.data(), val.data());
+      for (int c = 0; c < 3; ++c) {
+        double s = fixed_values[c][k];
+        for (int a = 0; a < L; ++a) s += val[a] * Y(idx[a], c);
+        const double e = (exact_error ? model_log_value(s, opt) : s) - d.g[c][k];
+        se += d.w[k] * e * e;
+      }
     }
+    sol.rel_mse = se / (3.0 * d.W);
   }
-  sol.rel_mse = se / (3.0 * d.W);
 
   for (size_t ti = 0; ti < terms.size(); ++ti) {
     const TermLayout& t = terms[ti];

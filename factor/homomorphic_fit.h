@@ -79,7 +79,11 @@ class FitData {
 
 struct JointSolution {
   std::vector<FactorTerm> terms;  // the joint terms with texels and masks
-  double rel_mse = 0;             // objective of fixed + joint terms on the fit data
+  // rel_mse of fixed + joint terms on the fit data. With exact_error (default)
+  // it is computed sample by sample with the reconstruction's clamping, as the
+  // metrics see it; otherwise it is the least-squares objective itself
+  // (unclamped), read off the normal equations in O(unknowns) (search loop).
+  double rel_mse = 0;
   size_t unknowns = 0;            // texels solved for (all joint terms)
 };
 
@@ -90,7 +94,8 @@ std::array<std::vector<double>, 3> fixed_sum(const FitData& d, const std::vector
 // std::invalid_argument for invalid projections, std::runtime_error if the
 // normal matrix is not positive definite.
 JointSolution solve_joint(const FitData& d, const std::array<std::vector<double>, 3>& fixed_values,
-                          const std::vector<TermSpec>& joint, const FitOptions& opt);
+                          const std::vector<TermSpec>& joint, const FitOptions& opt,
+                          bool exact_error = true);
 
 // rel_mse of a log-space model value s against target g (both per sample and
 // channel), with the reconstruction's clamping applied exactly as the metrics
