@@ -7,12 +7,14 @@
 #include <nlohmann/json.hpp>
 #include <random>
 #include <ctime>
+#include <thread>
 
 #include "brdfs/catalogue.h"
 #include "brdfs/sampleset.h"
 #include "experiments/commands.h"
 #include "factor/homomorphic_fit.h"
 #include "search/rotation4.h"
+#include "search/term_search.h"
 
 namespace bf {
 
@@ -111,6 +113,68 @@ void run_bench_fit(const BenchFitArgs& a) {
   j["threads"] = 1;
   std::cout << j.dump() << std::endl;
 }
+struct BenchSearchArgs {
+  std::string brdf = "bluepaint";
+  int grid = 16;
+  int texture = 16;
+  int search_texture = 0;
+  int terms = 5;
+  int restarts = 6;
+  int solve_last = 2;
+  std::string param = "wiwo";
+  bool reciprocity = false;
+  unsigned long long seed = 1;
+  std::string optimizer = "powell";
+  int threads = 0;
+  double ftol = PowellOptions{}.ftol;
+  double line_tol = PowellOptions{}.line_tol;
+  double smoothing = FitOptions{}.smoothing;
+  std::vector<std::string> guesses;
+};
+
+void run_bench_search(const BenchSearchArgs& a) {
+  const BrdfPtr brdf = Catalogue::builtin().make(a.brdf);
+  const SampleSet s = sample_grid(*brdf, a.grid);
+  SearchOptions opt;
+  opt.terms = a.terms;
+  opt.param = parse_parameterization(a.param);
+  opt.texture_size = a.texture;
+  opt.search_texture_size = a.search_texture;
+  opt.restarts = a.restarts;
+  opt.guesses = a.guesses;
+  opt.reciprocity = a.reciprocity;
+  opt.fit.solve_last = a.solve_last;
+  opt.fit.smoothing = a.smoothing;
+  opt.seed = a.seed;
+  opt.optimizer = a.optimizer;
+  opt.threads = a.threads;
+  opt.powell.ftol = a.ftol;
+  opt.powell.line_tol = a.line_tol;
+  const FitData d(s, opt.fit.eps);
+  const SearchResult r = search_factorization(d, opt);
+  nlohmann::json j;
+  j["bench"] = "search";
+  j["brdf"] = a.brdf;
+  j["parameterization"] = a.param;
+  j["reciprocity"] = a.reciprocity;
+  j["samples"] = d.size();
+  j["texture"] = a.texture;
+  j["search_texture"] = a.search_texture > 0 ? a.search_texture : a.texture;
+  j["terms"] = a.terms;
+  j["restarts"] = a.restarts;
+  j["optimizer"] = a.optimizer;
+  j["threads"] = a.threads > 0 ? a.threads : static_cast<int>(std::thread::hardware_concurrency());
+  j["seconds"] = r.seconds;
+  j["evaluations"] = r.evaluations;
+  j["ms_per_evaluation_wall"] = 1e3 * r.seconds / std::max(1, r.evaluations);
+  j["rel_mse_after_term"] = r.rel_mse_after_term;
+  nlohmann::json per = nlohmann::json::array();
+  for (const TermRecord& t : r.terms)
+    per.push_back({{"evaluations", t.evaluations}, {"seconds", t.seconds},
+                   {"search_rel_mse", t.search_rel_mse}, {"best_start", t.best_start}});
+  j["per_term"] = per;
+  std::cout << j.dump() << std::endl;
+}
 }  // namespace
 
 void add_cmd_bench(CLI::App& app) {
@@ -135,6 +199,28 @@ void add_cmd_bench(CLI::App& app) {
                 "score by a pass over the samples with the reconstruction's clamping (default: "
                 "the least-squares objective from the normal equations, as the search does)");
   fit->callback([a] { run_bench_fit(*a); });
+
+  auto* search = bench->add_subcommand("search", "Time the greedy projection search (all cores)");
+  auto b = std::make_shared<BenchSearchArgs>();
+  search->add_option("--brdf", b->brdf, "catalogue name or measured file")->capture_default_str();
+  search->add_option("--grid", b->grid, "regular res^4 parabolic grid")->capture_default_str();
+  search->add_option("--texture", b->texture, "final texture resolution")->capture_default_str();
+  search->add_option("--search-texture", b->search_texture, "texture during the search (0 = final)")
+      ->capture_default_str();
+  search->add_option("--terms", b->terms, "textures to build")->capture_default_str();
+  search->add_option("--restarts", b->restarts, "random starts per term")->capture_default_str();
+  search->add_option("--guesses", b->guesses, "extra starts: wi, wo, wi+wo");
+  search->add_option("--solve-last", b->solve_last, "terms solved jointly (n)")->capture_default_str();
+  search->add_option("--parameterization", b->param, "wiwo or halfdiff")->capture_default_str();
+  search->add_flag("--reciprocity", b->reciprocity, "read each texture through the conjugate too");
+  search->add_option("--seed", b->seed, "seed of the random starts")->capture_default_str();
+  search->add_option("--optimizer", b->optimizer, "powell, praxis, bobyqa, neldermead, sbplx, direct, crs")
+      ->capture_default_str();
+  search->add_option("--threads", b->threads, "threads for the restarts (0 = all cores)")->capture_default_str();
+  search->add_option("--ftol", b->ftol, "relative improvement per sweep to go on")->capture_default_str();
+  search->add_option("--line-tol", b->line_tol, "golden-section bracket width (t)")->capture_default_str();
+  search->add_option("--smoothing", b->smoothing, "Laplacian weight")->capture_default_str();
+  search->callback([b] { run_bench_search(*b); });
 }
 
 }  // namespace bf

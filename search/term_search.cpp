@@ -57,7 +57,9 @@ double TermObjective::operator()(const Rotation4& r) const {
   std::vector<TermSpec> joint = joint_known_;
   joint.push_back(spec(r.normalized()));
   try {
-    return solve_joint(data_, fixed_values_, joint, opt_.fit).rel_mse;
+    // The least-squares objective read off the normal equations (no pass over
+    // the samples); the final refit reports the clamped metric.
+    return solve_joint(data_, fixed_values_, joint, opt_.fit, /*exact_error=*/false).rel_mse;
   } catch (const std::runtime_error&) {
     return std::numeric_limits<double>::max();  // a failed solve is never chosen
   }
