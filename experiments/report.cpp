@@ -1,0 +1,172 @@
+// report.html (see report.h).
+#include "experiments/report.h"
+
+#include <filesystem>
+#include <regex>
+#include <sstream>
+
+#include "experiments/cli_util.h"
+
+namespace bf {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string esc(const std::string& s) {
+  std::string o;
+  for (char c : s) {
+    switch (c) {
+      case '&': o += "&amp;"; break;
+      case '<': o += "&lt;"; break;
+      case '>': o += "&gt;"; break;
+      case '"': o += "&quot;"; break;
+      default: o += c;
+    }
+  }
+  return o;
+}
+
+// Relative URL of a folder-relative path (each segment percent-encoded as needed).
+std::string url(const std::string& rel) {
+  std::string o;
+  for (unsigned char c : rel) {
+    if (std::isalnum(c) || c == '/' || c == '.' || c == '_' || c == '-') o += static_cast<char>(c);
+    else {
+      char buf[4];
+      std::snprintf(buf, sizeof buf, "%%%02X", c);
+      o += buf;
+    }
+  }
+  return o;
+}
+
+const char* kStyle = R"(
+body{font-family:system-ui,-apple-system,Segoe UI,Helvetica,Arial,sans-serif;margin:2em;color:#222;max-width:1400px}
+h1{font-size:1.6em}h2{font-size:1.25em;margin-top:2em;border-bottom:1px solid #ddd}
+table{border-collapse:collapse;font-size:0.82em}td,th{border:1px solid #ccc;padding:2px 6px;text-align:right}
+th{background:#f0f0f0;position:sticky;top:0}td.t{text-align:left}tr.failed td{background:#fde8e8}
+.plots img{max-width:45%;margin:0.5em;border:1px solid #ddd}
+.run{border:1px solid #ddd;border-radius:6px;padding:0.6em 1em;margin:1em 0}
+.run img.sphere{max-width:100%;image-rendering:pixelated}.run img.tex{height:96px;margin-right:4px;image-rendering:pixelated}
+.files a{margin-right:0.8em;font-size:0.85em}code{background:#f6f6f6;padding:0 3px}
+pre{background:#f6f6f6;padding:0.8em;overflow:auto;font-size:0.85em}
+)";
+
+bool exists_in(const std::string& dir, const std::string& rel) {
+  std::error_code ec;
+  return fs::exists(fs::path(dir) / rel, ec);
+}
+
+}  // namespace
+
+std::vector<std::string> html_links(const std::string& html) {
+  std::vector<std::string> out;
+  static const std::regex re(R"re((?:href|src)\s*=\s*"([^"]*)")re");
+  for (auto it = std::sregex_iterator(html.begin(), html.end(), re); it != std::sregex_iterator(); ++it)
+    out.push_back((*it)[1].str());
+  return out;
+}
+
+void write_report_html(const ExperimentOutput& e, const OutputFiles& f, const std::string& path) {
+  const std::string dir = fs::path(path).parent_path().string();
+  const std::string name = e.experiment.value("name", "experiment");
+  std::ostringstream h;
+  h << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\n<title>" << esc(name)
+    << " - brdf-factor</title>\n<style>" << kStyle << "</style></head><body>\n";
+  h << "<h1>Experiment " << esc(name) << "</h1>\n";
+  if (!e.experiment.value("description", "").empty())
+    h << "<p>" << esc(e.experiment.value("description", "")) << "</p>\n";
+  size_t failed = 0;
+  for (const auto& r : e.runs) failed += r.status != "ok";
+  h << "<p>" << e.runs.size() << " runs";
+  if (e.shards > 1) h << " (shard " << e.shard << "/" << e.shards << " of " << e.plan.size() << ")";
+  if (!e.merged_from.empty()) h << " (merged from " << e.merged_from.size() << " shard folders)";
+  if (failed) h << ", <b>" << failed << " failed</b>";
+  h << ". Config <code>" << esc(e.config_path) << "</code>";
+  for (const auto& d : e.defines) h << " <code>-D " << esc(d) << "</code>";
+  h << ".</p>\n<p class=\"files\">";
+  for (const char* file : {"results.csv", "results.md", "manifest.json", "config.toml"})
+    if (exists_in(dir, file)) h << "<a href=\"" << url(file) << "\">" << file << "</a>";
+  h << "</p>\n";
+
+  // Results table.
+  h << "<h2>Results</h2>\n<table><tr>";
+  std::vector<std::string> cols = required_columns();
+  cols.insert(cols.begin() + 3, "label");
+  cols.push_back("sampling");
+  cols.push_back("notes");
+  for (const auto& c : cols) h << "<th>" << esc(c) << "</th>";
+  h << "</tr>\n";
+  for (const auto& r : e.runs) {
+    h << "<tr" << (r.status != "ok" ? " class=\"failed\"" : "") << ">";
+    for (const auto& c : cols) {
+      auto it = r.row.find(c);
+      const std::string cell = it == r.row.end() ? "" : it->second;
+      const bool text = c == "run_id" || c == "brdf" || c == "method" || c == "label" || c == "parameterization" ||
+                        c == "sampling" || c == "notes" || c == "reciprocity";
+      h << "<td" << (text ? " class=\"t\"" : "") << ">";
+      if (c == "run_id") h << "<a href=\"#run-" << esc(cell) << "\">" << esc(cell) << "</a>";
+      else h << esc(text ? cell : format_short(cell));
+      h << "</td>";
+    }
+    h << "</tr>\n";
+  }
+  h << "</table>\n";
+
+  // Plots.
+  h << "<h2>Plots</h2>\n";
+  if (f.plots.empty()) h << "<p>No plots: " << esc(f.plots_note) << "</p>\n";
+  else {
+    h << "<div class=\"plots\">";
+    for (const auto& p : f.plots)
+      if (exists_in(dir, p)) {
+        const bool img = p.size() > 4 && (p.substr(p.size() - 4) == ".png" || p.substr(p.size() - 4) == ".svg");
+        if (img) h << "<a href=\"" << url(p) << "\"><img src=\"" << url(p) << "\" alt=\"" << esc(p) << "\"></a>";
+        else h << "<a href=\"" << url(p) << "\">" << esc(p) << "</a> ";
+      }
+    h << "</div>\n";
+  }
+
+  // Runs.
+  h << "<h2>Runs</h2>\n<p>Each picture: a unit sphere lit by a point light, rendered with the original BRDF "
+       "(left), the approximation (middle) and |difference| as a heat map (right; black = 0, white = 25% of the "
+       "original's display white).</p>\n";
+  for (const auto& r : e.runs) {
+    auto cell = [&](const char* c) {
+      auto it = r.row.find(c);
+      return it == r.row.end() ? std::string() : it->second;
+    };
+    h << "<div class=\"run\" id=\"run-" << esc(r.run_id) << "\"><h3>" << esc(r.run_id) << ": "
+      << esc(cell("brdf")) << " &middot; " << esc(cell("label")) << " &middot; " << esc(cell("sampling"))
+      << "</h3>\n";
+    h << "<p>rel_mse " << esc(format_short(cell("rel_mse"))) << ", lin_rmse " << esc(format_short(cell("lin_rmse")))
+      << ", cos_rmse " << esc(format_short(cell("cos_rmse"))) << ", " << esc(cell("storage_floats"))
+      << " floats, " << esc(format_short(cell("seconds"))) << " s";
+    if (!cell("notes").empty()) h << "<br>" << esc(cell("notes"));
+    h << "</p>\n";
+    std::vector<std::string> pictures, textures, others;
+    for (const auto& file : r.files) {
+      if (!exists_in(dir, file)) continue;
+      const std::string base = fs::path(file).filename().string();
+      if (base == "sphere.png") pictures.push_back(file);
+      else if (base.size() > 4 && base.substr(base.size() - 4) == ".png") textures.push_back(file);
+      else others.push_back(file);
+    }
+    for (const auto& p : pictures)
+      h << "<img class=\"sphere\" loading=\"lazy\" src=\"" << url(p) << "\" alt=\"sphere " << esc(r.run_id)
+        << "\"><br>\n";
+    for (const auto& p : textures)
+      h << "<a href=\"" << url(p) << "\"><img class=\"tex\" loading=\"lazy\" src=\"" << url(p) << "\" alt=\""
+        << esc(fs::path(p).filename().string()) << "\"></a>";
+    h << "<p class=\"files\">";
+    for (const auto& file : r.files)
+      if (exists_in(dir, file))
+        h << "<a href=\"" << url(file) << "\">" << esc(fs::path(file).filename().string()) << "</a>";
+    h << "</p></div>\n";
+  }
+  h << "<h2>Config</h2>\n<pre>" << esc(e.config_text) << "</pre>\n</body></html>\n";
+  write_file_atomic(path, [&](std::ostream& o) { o << h.str(); });
+}
+
+}  // namespace bf

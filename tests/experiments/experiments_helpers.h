@@ -1,0 +1,125 @@
+// Helpers shared by the experiments tests: scratch folders, config files,
+// quiet runs, CLI invocation.
+#pragma once
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "brdfs/catalogue.h"
+#include "experiments/runner.h"
+#include "factor/export.h"
+#include "test_common.h"
+
+namespace bf_test {
+
+namespace fs = std::filesystem;
+
+// A fresh folder under the system temp dir, removed when the object dies.
+struct ScratchDir {
+  fs::path path;
+  ScratchDir() {
+    std::random_device rd;
+    path = fs::temp_directory_path() / ("bf-exp-test-" + std::to_string(rd()) + std::to_string(rd()));
+    fs::create_directories(path);
+  }
+  ~ScratchDir() {
+    std::error_code ec;
+    fs::remove_all(path, ec);
+  }
+  std::string operator/(const std::string& rel) const { return (path / rel).string(); }
+};
+
+inline std::string write_text(const std::string& path, const std::string& text) {
+  fs::create_directories(fs::path(path).parent_path());
+  std::ofstream(path) << text;
+  return path;
+}
+
+inline std::string read_text(const std::string& path) {
+  std::ifstream in(path);
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+inline void register_loaders() {
+  static bool done = [] {
+    bf::register_export_loader(bf::Catalogue::global());
+    return true;
+  }();
+  (void)done;
+}
+
+// Runs an experiment quietly (no plots unless asked); returns the summary.
+inline bf::RunSummary run_quiet(const std::string& config, const std::string& out,
+                                std::vector<std::string> defines = {}, bool plots = false,
+                                bool force = false, int shard = 1, int shards = 1) {
+  register_loaders();
+  bf::RunOptions o;
+  o.config = config;
+  o.out = out;
+  o.defines = std::move(defines);
+  o.quiet = true;
+  o.plots = plots;
+  o.force = force;
+  o.shard = shard;
+  o.shards = shards;
+  std::ostringstream sout, serr;
+  return bf::run_experiment(o, sout, serr);
+}
+
+// The CLI's exit code and its stderr/stdout (merged into *output).
+inline int run_cli(const std::string& args, std::string* output) {
+  const std::string cmd = std::string(BF_CLI_PATH) + " " + args + " 2>&1";
+  FILE* p = popen(cmd.c_str(), "r");
+  std::string out;
+  char buf[4096];
+  size_t n;
+  while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) out.append(buf, n);
+  const int st = pclose(p);
+  if (output) *output = out;
+  return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+
+inline std::string source_path(const std::string& rel) {
+  return std::string(BRDF_FACTOR_SOURCE_DIR) + "/" + rel;
+}
+
+// A small, fast experiment: bluepaint on a 6^4 grid, three cheap methods.
+inline const char* kTinyConfig = R"(
+[experiment]
+name = "tiny"
+seed = 5
+
+[[brdf]]
+preset = "bluepaint"
+
+[sampling]
+kind = "grid"
+resolution = 6
+
+[scene]
+size = 24
+
+[[method]]
+kind = "mccool"
+texture_size = [4, 6]
+
+[[method]]
+kind = "fit"
+projections = [{ name = "wi" }, { name = "h" }]
+terms = [1, 2]
+texture_size = 6
+
+[[method]]
+kind = "svd"
+terms = 1
+texture_size = 6
+)";
+
+}  // namespace bf_test
