@@ -45,6 +45,21 @@ const std::vector<std::string>& result_columns() {
   return c;
 }
 
+std::vector<std::string> display_columns(const std::vector<RunEntry>& runs) {
+  std::vector<std::string> cols = required_columns();
+  cols.insert(cols.begin() + 3, "label");
+  for (const char* extra : {"order", "view_order", "tolerance", "tolerance_reached", "shade_rmse", "seed",
+                            "sampling", "notes"})
+    for (const auto& r : runs) {
+      auto it = r.row.find(extra);
+      if (it != r.row.end() && !it->second.empty()) {
+        cols.push_back(extra);
+        break;
+      }
+    }
+  return cols;
+}
+
 std::string format_number(double v) {
   if (!std::isfinite(v)) return "";
   char buf[40];
@@ -256,10 +271,7 @@ void write_results_md(const ExperimentOutput& e, const OutputFiles& f, const std
       << x.value("metric_eps", json(1e-5)).dump() << "); `seconds` is the method's wall time\n";
     o << "- files: [results.csv](results.csv) (full precision and extra columns), "
          "[manifest.json](manifest.json), [report.html](report.html)\n\n";
-    std::vector<std::string> cols = required_columns();
-    cols.insert(cols.begin() + 3, "label");
-    cols.push_back("sampling");
-    cols.push_back("notes");
+    const std::vector<std::string> cols = display_columns(e.runs);
     o << "|";
     for (const auto& c : cols) o << " " << c << " |";
     o << "\n|";

@@ -27,6 +27,13 @@ const std::vector<std::string>& result_columns();
 // One results row: column -> cell text; a missing column is an empty cell.
 using Row = std::map<std::string, std::string>;
 
+struct RunEntry;
+// Columns of the tables for people (results.md, report.html): the required
+// ones with `label` after `method`, then those extras that some row fills
+// (order, view_order, tolerance, tolerance_reached, shade_rmse, seed,
+// sampling, notes).
+std::vector<std::string> display_columns(const std::vector<RunEntry>& runs);
+
 // Numbers as cells: %.9g; "" for NaN or infinity (never written as text).
 std::string format_number(double v);
 // Short form for people (results.md): 4 significant digits.

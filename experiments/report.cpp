@@ -92,10 +92,7 @@ void write_report_html(const ExperimentOutput& e, const OutputFiles& f, const st
 
   // Results table.
   h << "<h2>Results</h2>\n<table><tr>";
-  std::vector<std::string> cols = required_columns();
-  cols.insert(cols.begin() + 3, "label");
-  cols.push_back("sampling");
-  cols.push_back("notes");
+  const std::vector<std::string> cols = display_columns(e.runs);
   for (const auto& c : cols) h << "<th>" << esc(c) << "</th>";
   h << "</tr>\n";
   for (const auto& r : e.runs) {

@@ -342,7 +342,7 @@ RunEntry execute_run(const Plan& plan, const PlannedRun& pr, const SampleSet& sa
     row["texture_size"] = std::to_string(shk->options().view_res);
     row["order"] = std::to_string(shk->order());
     if (shk->negative_fraction > 0)
-      notes.push_back("ringing: product negative at " + format_number(100.0 * shk->negative_fraction) +
+      notes.push_back("ringing: product negative at " + format_short(format_number(100.0 * shk->negative_fraction)) +
                       "% of the quadrature nodes");
   } else if (auto shr = std::dynamic_pointer_cast<const ShrFactorization>(f)) {
     row["order"] = std::to_string(shr->order());

@@ -1,0 +1,46 @@
+// The per-run sphere picture and shade_rmse.
+#include <OpenImageIO/imageio.h>
+
+#include "brdfs/catalogue.h"
+#include "experiments/render.h"
+#include "experiments_helpers.h"
+
+using namespace bf;
+using namespace bf_test;
+
+TEST_CASE("render: the sphere is lit where the light sees it, and shade_rmse compares renders") {
+  const BrdfPtr lambert = Catalogue::builtin().make("lambert:kd=0.5");
+  SceneSettings scene;
+  scene.size = 32;
+  scene.light = Vec3(0.0, 0.0, 5.0);  // on the camera axis
+  const SphereRender a = render_sphere(*lambert, scene);
+  REQUIRE(a.L.size() == 32u * 32u);
+  // Centre pixel: n = +z, wi = +z, d = 4: L = I * kd/pi * 1 / 16.
+  const size_t centre = 16 * 32 + 16;
+  CHECK(a.inside[centre] == 1);
+  CHECK(near_rel(a.L[centre][0], scene.intensity * 0.5 / M_PI / 16.0, 0.02));
+  CHECK(a.inside[0] == 0);
+  CHECK(a.L[0].isZero());
+  CHECK(shade_rmse(a, a) == 0.0);
+
+  const BrdfPtr brighter = Catalogue::builtin().make("lambert:kd=1");
+  const SphereRender b = render_sphere(*brighter, scene);
+  CHECK(shade_rmse(a, b) > 0.0);
+
+  ScratchDir tmp;
+  const std::string png = tmp / "sphere.png";
+  write_comparison_png(a, b, png);
+  auto in = OIIO::ImageInput::open(png);
+  REQUIRE(in);
+  CHECK(in->spec().width == 3 * 32 + 2 * 4);
+  CHECK(in->spec().height == 32);
+  CHECK(in->spec().nchannels == 3);
+  in->close();
+  // Nothing but the picture is left in the folder (no temporary).
+  size_t files = 0;
+  for (const auto& e : fs::directory_iterator(tmp.path)) files += e.is_regular_file();
+  CHECK(files == 1);
+  SceneSettings other = scene;
+  other.size = 16;
+  CHECK_THROWS(shade_rmse(a, render_sphere(*lambert, other)));
+}
