@@ -20,6 +20,7 @@ int main(int argc, char** argv) {
   bf::add_cmd_bench(app);
   bf::add_cmd_run(app);
   bf::add_cmd_merge(app);
+  bf::add_cmd_stress(app);
   try {
     bf::register_export_loader(bf::Catalogue::global());
     app.parse(argc, argv);
