@@ -37,7 +37,7 @@ const std::vector<std::string>& required_columns() {
 const std::vector<std::string>& result_columns() {
   static const std::vector<std::string> c = [] {
     std::vector<std::string> v = required_columns();
-    for (const char* e : {"label", "sampling", "seed", "status", "errors_after_term", "negative_texels",
+    for (const char* e : {"label", "sampling", "sweep", "seed", "status", "errors_after_term", "negative_texels",
                           "order", "view_order", "tolerance", "tolerance_reached", "shade_rmse", "notes"})
       v.push_back(e);
     return v;
@@ -49,7 +49,7 @@ std::vector<std::string> display_columns(const std::vector<RunEntry>& runs) {
   std::vector<std::string> cols = required_columns();
   cols.insert(cols.begin() + 3, "label");
   for (const char* extra : {"order", "view_order", "tolerance", "tolerance_reached", "shade_rmse", "seed",
-                            "sampling", "notes"})
+                            "sampling", "sweep", "notes"})
     for (const auto& r : runs) {
       auto it = r.row.find(extra);
       if (it != r.row.end() && !it->second.empty()) {

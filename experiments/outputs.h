@@ -19,7 +19,7 @@ inline constexpr const char* kBrdfFactorVersion = "0.1.0";
 
 // results.csv columns: DESIGN.md §5's, exactly and in that order...
 const std::vector<std::string>& required_columns();
-// ...then the extras: label, sampling, seed, status, errors_after_term,
+// ...then the extras: label, sampling, sweep, seed, status, errors_after_term,
 // negative_texels, order, view_order, tolerance, tolerance_reached,
 // shade_rmse, notes (docs/experiments.md says what each holds).
 const std::vector<std::string>& result_columns();
@@ -31,7 +31,7 @@ struct RunEntry;
 // Columns of the tables for people (results.md, report.html): the required
 // ones with `label` after `method`, then those extras that some row fills
 // (order, view_order, tolerance, tolerance_reached, shade_rmse, seed,
-// sampling, notes).
+// sampling, sweep, notes).
 std::vector<std::string> display_columns(const std::vector<RunEntry>& runs);
 
 // Numbers as cells: %.9g; "" for NaN or infinity (never written as text).

@@ -38,6 +38,8 @@ def load(path):
 def series_key(r):
     label = r.get("label") or r.get("method", "")
     parts = [label]
+    # The sweep values of the run, except the x axis (terms).
+    parts += [kv for kv in (r.get("sweep") or "").split() if not kv.startswith("terms=")]
     if r.get("parameterization"):
         parts.append(r["parameterization"])
     if r.get("reciprocity") == "true":
@@ -146,7 +148,9 @@ def main():
         fig, ax = plt.subplots(figsize=(6.5, 4.5))
         groups = OrderedDict()
         for x, y, r in pts:
-            groups.setdefault((r.get("label") or r["method"]) + " / " + r["brdf"], []).append((x, y))
+            sweep = (r.get("sweep") or "").split()
+            key = (r.get("label") or r["method"]) + (" " + sweep[0] if sweep else "") + " / " + r["brdf"]
+            groups.setdefault(key, []).append((x, y))
         for key, g in groups.items():
             ax.scatter([p[0] for p in g], [p[1] for p in g], label=key, s=22)
         front = pareto([(x, y) for x, y, _ in pts])

@@ -101,7 +101,8 @@ void write_report_html(const ExperimentOutput& e, const OutputFiles& f, const st
       auto it = r.row.find(c);
       const std::string cell = it == r.row.end() ? "" : it->second;
       const bool text = c == "run_id" || c == "brdf" || c == "method" || c == "label" || c == "parameterization" ||
-                        c == "sampling" || c == "notes" || c == "reciprocity";
+                        c == "sampling" || c == "notes" || c == "reciprocity" || c == "sweep" ||
+                        c == "tolerance";
       h << "<td" << (text ? " class=\"t\"" : "") << ">";
       if (c == "run_id") h << "<a href=\"#run-" << esc(cell) << "\">" << esc(cell) << "</a>";
       else h << esc(text ? cell : format_short(cell));
@@ -135,7 +136,8 @@ void write_report_html(const ExperimentOutput& e, const OutputFiles& f, const st
       return it == r.row.end() ? std::string() : it->second;
     };
     h << "<div class=\"run\" id=\"run-" << esc(r.run_id) << "\"><h3>" << esc(r.run_id) << ": "
-      << esc(cell("brdf")) << " &middot; " << esc(cell("label")) << " &middot; " << esc(cell("sampling"))
+      << esc(cell("brdf")) << " &middot; " << esc(cell("label")) << " " << esc(cell("sweep")) << " &middot; "
+      << esc(cell("sampling"))
       << "</h3>\n";
     h << "<p>rel_mse " << esc(format_short(cell("rel_mse"))) << ", lin_rmse " << esc(format_short(cell("lin_rmse")))
       << ", cos_rmse " << esc(format_short(cell("cos_rmse"))) << ", " << esc(cell("storage_floats"))

@@ -200,7 +200,22 @@ std::vector<std::string> list_files(const fs::path& exp_dir, const fs::path& run
   return files;
 }
 
+// The options in which a method variant differs from the other variants of
+// its [[method]] table (its sweep values), as "key=value ...".
+std::string sweep_of(const Plan& plan, size_t method) {
+  const MethodVariant& m = plan.methods[method];
+  std::vector<std::string> parts;
+  for (const auto& [k, v] : m.options.items()) {
+    bool varies = false;
+    for (const auto& o : plan.methods)
+      if (&o != &m && o.where == m.where && (!o.options.contains(k) || o.options[k] != v)) varies = true;
+    if (varies) parts.push_back(k + "=" + (v.is_string() ? v.get<std::string>() : v.dump()));
+  }
+  return join(parts, " ");
+}
+
 void set_presentation(Row& row, const Plan& plan, const PlannedRun& r) {
+  row["sweep"] = sweep_of(plan, r.method);
   row["run_id"] = r.run_id;
   row["brdf"] = plan.brdfs[r.brdf].label;
   row["method"] = plan.methods[r.method].kind;

@@ -5,7 +5,7 @@
 #   CONFIG=experiments/thesis-bluepaint.toml OUT=results/thesis-bluepaint N=8 \
 #     sbatch --array=1-8 experiments/slurm-array.sh
 #   # when all tasks are done (or chain it: sbatch --dependency=afterok:<jobid> ...):
-#   brdf-factor merge results/thesis-bluepaint/shard-*-of-8 --out results/thesis-bluepaint/merged
+#   brdf-factor merge results/thesis-bluepaint/shard-*-of-8 --out results/thesis-bluepaint
 #
 # Each task runs `brdf-factor run --shard K/N`, which executes a deterministic
 # 1/N of the runs (run i when i mod N = K-1) into OUT/shard-K-of-N. A task
