@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Configures and builds brdf-factor (Release, -march=native) into ./build.
+# Configures and builds brdf-factor (Release, portable; pass -DBRDF_FACTOR_NATIVE=ON
+# for -march=native) into ./build.
 # Usage: scripts/build.sh [extra cmake args...]
 set -euo pipefail
 cd "$(dirname "$0")/.."
