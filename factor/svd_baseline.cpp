@@ -305,6 +305,16 @@ std::shared_ptr<SvdFactorization> fit_svd(const SvdTable& table, const SvdOption
   if (table.grid.res != opt.res || table.param != opt.param || table.log != opt.log)
     throw std::invalid_argument("svd: the table was built with different options (res, "
                                 "parameterization or log) than the fit asks for");
+  // A linear table whose largest value is subnormal cannot be factored and
+  // evaluated without underflow to 0 or overflow of 1/value: a clear error.
+  for (int c = 0; c < 3; ++c) {
+    const double amax = table.M[c].cwiseAbs().maxCoeff();
+    if (amax > 0.0 && amax < std::numeric_limits<double>::min())
+      throw std::invalid_argument("svd: channel " + std::to_string(c) +
+                                  " of the table is denormal (largest value " +
+                                  std::to_string(amax) +
+                                  "): rescale the BRDF or use log = true");
+  }
   const auto t0 = std::chrono::steady_clock::now();
   std::array<TruncatedSvd, 3> s;
   for (int c = 0; c < 3; ++c) s[c] = truncated_svd(table.M[c], opt.rank);

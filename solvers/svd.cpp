@@ -21,10 +21,14 @@ TruncatedSvd truncated_svd(const Eigen::MatrixXd& A, int rank) {
   if (rank < 1) throw std::invalid_argument("svd: rank must be >= 1, found " + std::to_string(rank));
   if (A.size() == 0) throw std::invalid_argument("svd: the matrix is empty");
   if (!A.allFinite()) throw std::invalid_argument("svd: the matrix has non-finite entries");
-  Eigen::BDCSVD<Eigen::MatrixXd> svd(A, Eigen::ComputeThinU | Eigen::ComputeThinV);
+  // SVD is homogeneous: decompose A / max|A| and scale the singular values back,
+  // so tables of denormal (or huge) values never meet 1/norm overflow inside the SVD.
+  const double amax = A.cwiseAbs().maxCoeff();
+  const double scale = amax > 0.0 ? amax : 1.0;
+  Eigen::BDCSVD<Eigen::MatrixXd> svd(A / scale, Eigen::ComputeThinU | Eigen::ComputeThinV);
   const int K = std::min<int>(rank, int(svd.singularValues().size()));
   TruncatedSvd r;
-  r.sigma = svd.singularValues();
+  r.sigma = svd.singularValues() * scale;
   r.U = svd.matrixU().leftCols(K);
   r.V = svd.matrixV().leftCols(K);
   for (int k = 0; k < K; ++k)

@@ -76,7 +76,7 @@ TEST_CASE("examples: thesis-setup at reduced size") {
 
 TEST_CASE("examples: thesis-measured at reduced size") {
   run_example("thesis-measured",
-              {"method.texture_size=6", "method.restarts=1", "method.terms=2", "scene.size=24"}, 9);
+              {"method.texture_size=6", "method.restarts=1", "method.terms=2", "scene.size=24"}, 15);
 }
 
 TEST_CASE("examples: parameterizations at reduced size") {
