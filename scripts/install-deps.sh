@@ -2,6 +2,11 @@
 # Installs every Debian 12 package brdf-factor needs to build, test and make its
 # reports. Idempotent: packages already present are not touched, and apt is only
 # called when something is missing. Run as root (or with sudo available).
+#   scripts/install-deps.sh           what the default build, tests and reports need
+#   scripts/install-deps.sh --fuzz    also clang and its libFuzzer/sanitizer
+#                                     runtimes, for fuzz/run.sh (build-fuzz/)
+# The sanitizer test build (scripts/test-sanitize.sh) uses gcc's ASan/UBSan
+# runtimes (libasan8, libubsan1), which build-essential already brings.
 set -euo pipefail
 
 PACKAGES=(
@@ -18,6 +23,14 @@ PACKAGES=(
   glslang-tools          # compiles the generated GLSL in a test
   python3-matplotlib     # plots in experiment reports
 )
+case "${1:-}" in
+  "") ;;
+  --fuzz) PACKAGES+=(
+    clang                  # clang++ 14 (fuzz/run.sh configures with CC=clang CXX=clang++)
+    libclang-rt-14-dev     # libFuzzer, ASan and UBSan runtimes for clang 14
+  ) ;;
+  *) echo "install-deps: unknown argument '$1' (expected nothing or --fuzz)" >&2; exit 2 ;;
+esac
 
 missing=()
 for p in "${PACKAGES[@]}"; do
