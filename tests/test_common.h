@@ -2,10 +2,14 @@
 #pragma once
 
 #include <catch2/catch.hpp>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <string>
 
 #include "brdfs/brdf.h"
@@ -38,5 +42,28 @@ struct TempDir {
   }
   std::string file(const std::string& name) const { return (path / name).string(); }
 };
+
+// The whole file as bytes ("" when it cannot be read).
+inline std::string slurp(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+#ifdef BF_CLI_PATH
+// Runs the brdf-factor CLI with `args` (stdout discarded); returns its exit
+// code (-1 when it did not exit normally, e.g. a crash), stderr into *err.
+inline int run_cli_stderr(const std::string& args, std::string* err) {
+  TempDir d("cli");
+  const std::string errfile = d.file("stderr.txt");
+  // Appended piecewise: GCC 12 warns (-Wrestrict, a false positive) on a chain of +.
+  std::string cmd = BF_CLI_PATH;
+  cmd.append(" ").append(args).append(" > /dev/null 2> ").append(errfile);
+  const int status = std::system(cmd.c_str());
+  if (err) *err = slurp(errfile);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+#endif
 
 }  // namespace bf_test

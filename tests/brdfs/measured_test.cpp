@@ -35,20 +35,7 @@ std::string cornell(const std::string& name) {
   return data_dir() + "/cornell/" + name;
 }
 
-// Runs the CLI with arguments; returns the exit code, stderr into *err.
-int run_cli(const std::string& args, std::string* err) {
-  TempDir d("cli");
-  const std::string errfile = d.file("stderr.txt");
-  // Appended piecewise: GCC 12 warns (-Wrestrict, a false positive) on a chain of +.
-  std::string cmd = BF_CLI_PATH;
-  cmd.append(" ").append(args).append(" > /dev/null 2> ").append(errfile);
-  const int status = std::system(cmd.c_str());
-  std::ifstream in(errfile);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  if (err) *err = ss.str();
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
+const auto run_cli = bf_test::run_cli_stderr;
 
 double deg(double d) {
   return d * M_PI / 180.0;

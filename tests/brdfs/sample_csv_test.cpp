@@ -27,12 +27,7 @@ std::string bad(const std::string& name) {
   return std::string(BF_TEST_DATA_DIR) + "/measured/" + name;
 }
 
-std::string slurp(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+using bf_test::slurp;
 
 }  // namespace
 
