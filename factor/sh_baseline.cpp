@@ -10,11 +10,13 @@
 #include <stdexcept>
 #include <tuple>
 
+#include "factor/isotropy.h"
 #include "factor/metrics.h"
 #include "factor/projection.h"
 #include "solvers/parallel.h"
 #include "solvers/quadrature.h"
 #include "solvers/sh.h"
+#include "solvers/sh_rotation.h"
 
 namespace bf {
 
@@ -64,17 +66,32 @@ ShkFactorization::ShkFactorization(const ShkOptions& opt, DiskGrid grid,
     : opt_(opt), grid_(std::move(grid)), basis_(opt.order), coeffs_(std::move(coeffs)),
       seconds_(seconds) {
   for (int c = 0; c < 3; ++c) {
-    if (coeffs_[c].rows() != sh_count(opt_.order) || coeffs_[c].cols() != Eigen::Index(grid_.count()))
+    const Eigen::Index cols = opt_.reduced ? Eigen::Index(opt_.view_res) : Eigen::Index(grid_.count());
+    if (coeffs_[c].rows() != sh_count(opt_.order) || coeffs_[c].cols() != cols)
       throw std::invalid_argument("sh-k factorization: coefficient matrix is " +
                                   std::to_string(coeffs_[c].rows()) + " x " +
                                   std::to_string(coeffs_[c].cols()) + ", expected " +
                                   std::to_string(sh_count(opt_.order)) + " x " +
-                                  std::to_string(grid_.count()));
+                                  std::to_string(cols));
     if (opt_.float_textures) coeffs_[c] = coeffs_[c].cast<float>().cast<double>();
   }
 }
 
 Eigen::MatrixXd ShkFactorization::coefficients_at(const Vec3& wo) const {
+  if (opt_.reduced) {
+    const Vec2 p = parabolic(wo);
+    const int R = opt_.view_res;
+    const double s = std::clamp(p.norm(), 0.0, 1.0) * (R - 1);
+    const int j = std::min(int(s), R - 2);
+    const double t = s - j;
+    const double phi = std::atan2(p.y(), p.x());
+    Eigen::MatrixXd out(sh_count(opt_.order), 3);
+    for (int c = 0; c < 3; ++c) {
+      out.col(c) = (1.0 - t) * coeffs_[c].col(j) + t * coeffs_[c].col(j + 1);
+      sh_rotate_z(opt_.order, phi, out.col(c).data());
+    }
+    return out;
+  }
   const Bilinear b = bilinear(grid_.coords(parabolic(wo)), grid_.res);
   Eigen::MatrixXd out = Eigen::MatrixXd::Zero(sh_count(opt_.order), 3);
   for (int q = 0; q < 4; ++q) {
@@ -99,14 +116,16 @@ Rgb ShkFactorization::eval(const Vec3& wi, const Vec3& wo) const {
 }
 
 size_t ShkFactorization::storage_floats() const {
-  return grid_.count() * size_t(sh_count(opt_.order)) * 3;
+  return (opt_.reduced ? size_t(opt_.view_res) : grid_.count()) * size_t(sh_count(opt_.order)) * 3;
 }
 
 std::vector<double> ShkFactorization::texture(int c, int i) const {
   if (c < 0 || c > 2 || i < 0 || i >= sh_count(opt_.order))
     throw std::invalid_argument("sh-k: texture index out of range");
   std::vector<double> t(size_t(grid_.res) * grid_.res, 0.0);
-  for (size_t a = 0; a < grid_.count(); ++a) t[grid_.texels[a]] = coeffs_[c](i, Eigen::Index(a));
+  for (size_t a = 0; a < grid_.count(); ++a)
+    t[grid_.texels[a]] = opt_.reduced ? coefficients_at(grid_.direction(grid_.texels[a], opt_.rim_inset))(i, c)
+                                      : coeffs_[c](i, Eigen::Index(a));
   return t;
 }
 
@@ -129,8 +148,10 @@ std::shared_ptr<ShkFactorization> ShkFactorization::truncated(int k) const {
 
 std::string ShkFactorization::to_string() const {
   std::ostringstream os;
-  os << "sh-k(order " << opt_.order << ", " << sh_count(opt_.order) << " coefficients, view "
-     << grid_.res << "x" << grid_.res << ")";
+  os << "sh-k(order " << opt_.order << ", " << sh_count(opt_.order) << " coefficients, view ";
+  if (opt_.reduced) os << grid_.res << " radial (isotropic, phi_v = 0)";
+  else os << grid_.res << "x" << grid_.res;
+  os << ")";
   return os.str();
 }
 
@@ -149,7 +170,13 @@ nlohmann::json ShkFactorization::describe() const {
   j["view_resolution"] = grid_.res;
   j["view_map"] = "parabolic p(wo) = (x, y) / (1 + z)";
   j["texel_coords"] = "s = (p + 1) / 2 * (resolution - 1); texel (i, j) at s = (i, j), index j * resolution + i";
-  j["view_texels"] = grid_.count();
+  j["view_texels"] = opt_.reduced ? size_t(opt_.view_res) : grid_.count();
+  j["reduced"] = opt_.reduced;
+  if (opt_.reduced)
+    j["reduced_form"] =
+        "isotropic: column j holds c at the view of parabolic radius r_j = j/(resolution-1) (pulled in to "
+        "1 - rim_inset), azimuth 0; c(wo) = D(R_z(phi_v)) [linear interpolation in r = |p(wo)|], "
+        "D(R_z(a)): c'_lm = c_lm cos(m a) - c_l,-m sin(m a), c'_l,-m = c_lm sin(m a) + c_l,-m cos(m a), m > 0";
   j["rim_inset"] = opt_.rim_inset;
   j["quadrature"] = {{"theta_nodes", opt_.auto_theta_nodes()},
                      {"phi_nodes", opt_.auto_phi_nodes()},
@@ -180,7 +207,30 @@ std::shared_ptr<ShkFactorization> fit_shk(const Brdf& brdf, const ShkOptions& op
       Yw.row(k) = rule.w[k] * y.transpose();
     }
   }
-  const Eigen::Index T = Eigen::Index(grid.count());
+  if (opt.reduced) {
+    const IsotropyResult iso = test_isotropy(brdf);
+    if (!iso.isotropic)
+      throw std::invalid_argument("sh-k: reduced (isotropic) storage asked for " + brdf.to_string() +
+                                  ", but it is anisotropic: f changes by " + std::to_string(iso.max_rel_change) +
+                                  " (relative) when wi, wo rotate together about the normal (tolerance 1e-3)");
+  }
+  // View directions: the masked grid texels, or the phi_v = 0 radii (reduced).
+  std::vector<Vec3> views;
+  std::vector<uint8_t> view_inside;
+  if (opt.reduced) {
+    for (int j = 0; j < opt.view_res; ++j) {
+      const double r = std::min(double(j) / (opt.view_res - 1), 1.0 - opt.rim_inset);
+      views.push_back(parabolic_inverse(Vec2(r, 0.0)));
+      view_inside.push_back(1);
+    }
+  } else {
+    for (size_t a = 0; a < grid.count(); ++a) {
+      const int texel = grid.texels[a];
+      views.push_back(grid.direction(texel, opt.rim_inset));
+      view_inside.push_back(grid.point(texel).norm() <= 1.0 + 1e-12);
+    }
+  }
+  const Eigen::Index T = Eigen::Index(views.size());
   std::array<Eigen::MatrixXd, 3> coeffs;
   for (auto& C : coeffs) C.resize(n, T);
   // Views in chunks (so the sample matrix stays small at high resolutions),
@@ -198,9 +248,8 @@ std::shared_ptr<ShkFactorization> fit_shk(const Brdf& brdf, const ShkOptions& op
       const Eigen::Index nb = std::min(chunk, T - t0v);
       std::vector<uint8_t> inside(nb);
       for (Eigen::Index b = 0; b < nb; ++b) {
-        const int texel = grid.texels[t0v + b];
-        inside[b] = grid.point(texel).norm() <= 1.0 + 1e-12;
-        const Vec3 v = grid.direction(texel, opt.rim_inset);
+        inside[b] = view_inside[t0v + b];
+        const Vec3& v = views[t0v + b];
         for (Eigen::Index k = 0; k < Nq; ++k) {
           const Vec3& s = rule.dir[k];
           const Rgb f = brdf.eval(s, v);

@@ -40,6 +40,13 @@ struct ShkOptions {
   double rim_inset = 1e-4;  // DiskGrid: view texels beyond radius 1 - rim_inset are pulled in; (0, 0.1]
   double min_cos = 1e-2;    // eval() divides f* by max(cos theta_i, min_cos); (0, 1]
   bool float_textures = false;  // round coefficients to float (what an EXR export holds)
+  // Reduced storage for an isotropic BRDF: only the views of azimuth phi_v = 0,
+  // view_res texels at parabolic radii r_j = j/(view_res - 1) (pulled in to
+  // 1 - rim_inset like DiskGrid), linear in r; a view of azimuth phi_v reads
+  // c(wo) = D(R_z(phi_v)) c(r(wo)) (exact for isotropic f: rotating wi and wo
+  // together about n leaves f unchanged). fit_shk checks the BRDF with
+  // test_isotropy (factor/isotropy.h) and throws when it is anisotropic.
+  bool reduced = false;
   int auto_theta_nodes() const;
   int auto_phi_nodes() const;
   // Throws std::invalid_argument naming the field, its value and the rule.
@@ -53,7 +60,8 @@ struct ShkOptions {
 // least-squares fit over the sphere; Kautz et al. §3).
 class ShkFactorization final : public Factorization {
  public:
-  // coeffs[c]: (F+1)^2 x grid.count(), column a = view texel grid.texels[a].
+  // coeffs[c]: (F+1)^2 x grid.count(), column a = view texel grid.texels[a];
+  // reduced: (F+1)^2 x view_res, column j = radius r_j on the phi_v = 0 line.
   ShkFactorization(const ShkOptions& opt, DiskGrid grid, std::array<Eigen::MatrixXd, 3> coeffs,
                    double seconds);
 
@@ -66,10 +74,10 @@ class ShkFactorization final : public Factorization {
   Eigen::MatrixXd coefficients_at(const Vec3& wo) const;
   std::string name() const override { return "sh-k"; }
   std::string to_string() const override;
-  bool isotropic() const override { return false; }
+  bool isotropic() const override { return opt_.reduced; }
   bool reciprocal() const override { return false; }
   std::string method() const override { return "sh-k"; }
-  // Masked view texels x (F+1)^2 x 3.
+  // Masked view texels x (F+1)^2 x 3; reduced: view_res x (F+1)^2 x 3.
   size_t storage_floats() const override;
   nlohmann::json describe() const override;
 
@@ -78,7 +86,8 @@ class ShkFactorization final : public Factorization {
   const DiskGrid& grid() const { return grid_; }
   // (F+1)^2 x grid().count() coefficient matrix of channel c.
   const Eigen::MatrixXd& coefficients(int c) const { return coeffs_[c]; }
-  // Full view_res^2 texture of coefficient i (sh_index(l, m)), channel c, 0 outside the mask.
+  // Full view_res^2 texture of coefficient i (sh_index(l, m)), channel c, 0 outside the mask
+  // (reduced: coefficients_at evaluated at the masked texels' directions).
   std::vector<double> texture(int c, int i) const;
   // The order-k prefix (k <= order()): same projections, fewer bands.
   std::shared_ptr<ShkFactorization> truncated(int k) const;

@@ -2,6 +2,7 @@
 #include "solvers/sh_rotation.h"
 
 #include <Eigen/LU>
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -71,6 +72,66 @@ Eigen::VectorXd sh_rotate(const Eigen::Matrix3d& R, const Eigen::VectorXd& c) {
     throw std::invalid_argument("sh rotation: coefficient count " + std::to_string(c.size()) +
                                 " is not a square (F+1)^2");
   return sh_rotation(order, R).apply(c);
+}
+
+void sh_rotate_z(int order, double angle, double* c) {
+  for (int l = 1; l <= order; ++l)
+    for (int m = 1; m <= l; ++m) {
+      const double cm = std::cos(m * angle), sm = std::sin(m * angle);
+      double& p = c[sh_index(l, m)];
+      double& n = c[sh_index(l, -m)];
+      const double a = p, b = n;
+      p = a * cm - b * sm;
+      n = a * sm + b * cm;
+    }
+}
+
+ShFastRotator::ShFastRotator(int order) : order_(order) {
+  if (order < 0 || order > 200)
+    throw std::invalid_argument("sh fast rotator: order: expected 0..200, found " + std::to_string(order));
+  Eigen::Matrix3d Rx;
+  Rx << 1, 0, 0, 0, 0, -1, 0, 1, 0;  // R_x(+90): y -> z
+  const ShRotation p = sh_rotation(order, Rx), m = sh_rotation(order, Rx.transpose());
+  xp_ = p.blocks;
+  xm_ = m.blocks;
+}
+
+void ShFastRotator::rotate_zyz(double a, double b, double g, double* c) const {
+  // D(Rz(a) Ry(b) Rz(g)) c = Z(a) Xm Z(b) Xp Z(g) c.
+  sh_rotate_z(order_, g, c);
+  Eigen::VectorXd tmp;
+  for (int l = 1; l <= order_; ++l) {
+    Eigen::Map<Eigen::VectorXd> seg(c + l * l, 2 * l + 1);
+    tmp = xp_[l] * seg;
+    seg = tmp;
+  }
+  sh_rotate_z(order_, b, c);
+  for (int l = 1; l <= order_; ++l) {
+    Eigen::Map<Eigen::VectorXd> seg(c + l * l, 2 * l + 1);
+    tmp = xm_[l] * seg;
+    seg = tmp;
+  }
+  sh_rotate_z(order_, a, c);
+}
+
+Eigen::Vector3d ShFastRotator::euler_zyz(const Eigen::Matrix3d& R) {
+  if (!R.allFinite() || (R * R.transpose() - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() > 1e-9 ||
+      R.determinant() < 0.0)
+    throw std::invalid_argument("sh fast rotator: R is not a rotation to 1e-9");
+  // R = Rz(a) Ry(b) Rz(g): R(2,2) = cos b, R(0,2) = cos a sin b, R(1,2) = sin a sin b,
+  // R(2,0) = -sin b cos g, R(2,1) = sin b sin g.
+  const double cb = std::clamp(R(2, 2), -1.0, 1.0);
+  const double b = std::acos(cb);
+  const double sb = std::sqrt(R(0, 2) * R(0, 2) + R(1, 2) * R(1, 2));
+  if (sb > 1e-12) return {std::atan2(R(1, 2), R(0, 2)), b, std::atan2(R(2, 1), -R(2, 0))};
+  // Gimbal: b = 0 (R = Rz(a + g)) or b = pi (R = Rz(a) Ry(pi), g = 0).
+  if (cb > 0) return {std::atan2(R(1, 0), R(0, 0)), 0.0, 0.0};
+  return {std::atan2(-R(1, 0), -R(0, 0)), M_PI, 0.0};
+}
+
+void ShFastRotator::rotate(const Eigen::Matrix3d& R, double* c) const {
+  const Eigen::Vector3d e = euler_zyz(R);
+  rotate_zyz(e[0], e[1], e[2], c);
 }
 
 }  // namespace bf

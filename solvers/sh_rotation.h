@@ -40,4 +40,30 @@ ShRotation sh_rotation(int order, const Eigen::Matrix3d& R);
 // Convenience: sh_rotation(order, R).apply(c), order from c's size.
 Eigen::VectorXd sh_rotate(const Eigen::Matrix3d& R, const Eigen::VectorXd& c);
 
+// In place c <- D(R_z(angle)) c (same convention as ShRotation): for m > 0,
+//   c'_m = c_m cos(m a) - c_{-m} sin(m a),  c'_{-m} = c_m sin(m a) + c_{-m} cos(m a).
+// O((F+1)^2); c holds sh_count(order) values.
+void sh_rotate_z(int order, double angle, double* c);
+
+// Fast rotation of real SH coefficients by zyz Euler angles (Kautz et al.
+// 2002 Appendix, method 2): D(R_y(b)) = D(R_x(-90)) D(R_z(b)) D(R_x(+90)),
+// with the two fixed x-rotations built once, exactly, by sh_rotation. Cost per
+// rotation O(F^3) instead of sh_rotation's O(F^4).
+class ShFastRotator {
+ public:
+  explicit ShFastRotator(int order);  // order 0..200
+  int order() const { return order_; }
+  // c <- D(R) c for R = R_z(a) R_y(b) R_z(g) (c: sh_count(order) values).
+  void rotate_zyz(double a, double b, double g, double* c) const;
+  // c <- D(R) c for any rotation R (to 1e-9; Euler angles extracted, both
+  // gimbal cases handled). Throws std::invalid_argument for a non-rotation.
+  void rotate(const Eigen::Matrix3d& R, double* c) const;
+  // zyz angles (a, b, g) with R = R_z(a) R_y(b) R_z(g), b in [0, pi].
+  static Eigen::Vector3d euler_zyz(const Eigen::Matrix3d& R);
+
+ private:
+  int order_;
+  std::vector<Eigen::MatrixXd> xp_, xm_;  // D(R_x(+90)), D(R_x(-90)) per band
+};
+
 }  // namespace bf

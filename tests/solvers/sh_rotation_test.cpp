@@ -114,3 +114,44 @@ TEST_CASE("sh rotation: invalid input throws") {
   REQUIRE_THROWS_WITH(sh_rotation(2, Eigen::Matrix3d::Identity()).apply(Eigen::VectorXd::Zero(4)),
                       Catch::Contains("expected 9 coefficients"));
 }
+
+TEST_CASE("sh fast rotator: z rotation and zyz rotation equal the projected rotation matrices") {
+  std::mt19937_64 rng(21);
+  std::normal_distribution<double> N(0.0, 1.0);
+  const int F = 9;
+  Eigen::VectorXd c(sh_count(F));
+  for (int i = 0; i < c.size(); ++i) c[i] = N(rng);
+  // z only.
+  {
+    const double a = 0.7;
+    Eigen::VectorXd z = c;
+    sh_rotate_z(F, a, z.data());
+    const Eigen::Matrix3d Rz = Eigen::AngleAxisd(a, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    CHECK((z - sh_rotation(F, Rz).apply(c)).cwiseAbs().maxCoeff() < 1e-12);
+  }
+  const ShFastRotator fast(F);
+  for (int trial = 0; trial < 5; ++trial) {
+    const Eigen::Matrix3d R = random_rotation(rng);
+    Eigen::VectorXd r = c;
+    fast.rotate(R, r.data());
+    const double err = (r - sh_rotation(F, R).apply(c)).cwiseAbs().maxCoeff();
+    INFO("trial " << trial << ": max |fast - projected| = " << err);
+    CHECK(err < 1e-11);
+  }
+  // Gimbal cases: b = 0 and b = pi.
+  for (const Eigen::Matrix3d& R :
+       {Eigen::Matrix3d(Eigen::AngleAxisd(1.1, Eigen::Vector3d::UnitZ())),
+        Eigen::Matrix3d(Eigen::AngleAxisd(0.4, Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitY())),
+        Eigen::Matrix3d(Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX()))}) {
+    const Eigen::Vector3d e = ShFastRotator::euler_zyz(R);
+    const Eigen::Matrix3d back = (Eigen::AngleAxisd(e[0], Eigen::Vector3d::UnitZ()) *
+                                  Eigen::AngleAxisd(e[1], Eigen::Vector3d::UnitY()) *
+                                  Eigen::AngleAxisd(e[2], Eigen::Vector3d::UnitZ())).toRotationMatrix();
+    CHECK((back - R).cwiseAbs().maxCoeff() < 1e-12);
+    Eigen::VectorXd r = c;
+    fast.rotate(R, r.data());
+    CHECK((r - sh_rotation(F, R).apply(c)).cwiseAbs().maxCoeff() < 1e-11);
+  }
+  CHECK_THROWS_WITH(ShFastRotator::euler_zyz(Eigen::Matrix3d::Identity() * 2.0),
+                    Catch::Matchers::Contains("not a rotation"));
+}
