@@ -130,6 +130,9 @@ struct BenchSearchArgs {
   double line_tol = PowellOptions{}.line_tol;
   double smoothing = FitOptions{}.smoothing;
   std::vector<std::string> guesses;
+  int beam = 1;
+  int backfit_sweeps = 0;
+  int backfit_restarts = 0;
 };
 
 void run_bench_search(const BenchSearchArgs& a) {
@@ -150,8 +153,13 @@ void run_bench_search(const BenchSearchArgs& a) {
   opt.threads = a.threads;
   opt.powell.ftol = a.ftol;
   opt.powell.line_tol = a.line_tol;
+  opt.beam = a.beam;
+  opt.backfit_sweeps = a.backfit_sweeps;
+  opt.backfit_restarts = a.backfit_restarts;
   const FitData d(s, opt.fit.eps);
+  const std::clock_t c0 = std::clock();
   const SearchResult r = search_factorization(d, opt);
+  const double cpu = double(std::clock() - c0) / CLOCKS_PER_SEC;
   nlohmann::json j;
   j["bench"] = "search";
   j["brdf"] = a.brdf;
@@ -164,14 +172,24 @@ void run_bench_search(const BenchSearchArgs& a) {
   j["restarts"] = a.restarts;
   j["optimizer"] = a.optimizer;
   j["threads"] = a.threads > 0 ? a.threads : static_cast<int>(std::thread::hardware_concurrency());
+  j["beam"] = a.beam;
+  j["backfit_sweeps"] = a.backfit_sweeps;
+  j["backfit_restarts"] = a.backfit_restarts;
   j["seconds"] = r.seconds;
+  j["cpu_seconds"] = cpu;  // process CPU time, all threads
   j["evaluations"] = r.evaluations;
   j["ms_per_evaluation_wall"] = 1e3 * r.seconds / std::max(1, r.evaluations);
   j["rel_mse_after_term"] = r.rel_mse_after_term;
+  j["search_rel_mse"] = r.search_rel_mse;
+  if (r.beam_rel_mse.size() > 1) {
+    j["beam_rel_mse"] = r.beam_rel_mse;
+    j["best_branch"] = r.best_branch;
+  }
   nlohmann::json per = nlohmann::json::array();
   for (const TermRecord& t : r.terms)
     per.push_back({{"evaluations", t.evaluations}, {"seconds", t.seconds},
-                   {"search_rel_mse", t.search_rel_mse}, {"best_start", t.best_start}});
+                   {"search_rel_mse", t.search_rel_mse}, {"best_start", t.best_start},
+                   {"backfit_evaluations", t.backfit_evaluations}, {"backfit_moves", t.backfit_moves}});
   j["per_term"] = per;
   std::cout << j.dump() << std::endl;
 }
@@ -220,6 +238,11 @@ void add_cmd_bench(CLI::App& app) {
   search->add_option("--ftol", b->ftol, "relative improvement per sweep to go on")->capture_default_str();
   search->add_option("--line-tol", b->line_tol, "golden-section bracket width (t)")->capture_default_str();
   search->add_option("--smoothing", b->smoothing, "Laplacian weight")->capture_default_str();
+  search->add_option("--beam", b->beam, "first-term candidates continued (1 = greedy)")->capture_default_str();
+  search->add_option("--backfit-sweeps", b->backfit_sweeps, "cyclic re-search sweeps after each term")
+      ->capture_default_str();
+  search->add_option("--backfit-restarts", b->backfit_restarts, "random starts per re-search")
+      ->capture_default_str();
   search->callback([b] { run_bench_search(*b); });
 }
 

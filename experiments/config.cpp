@@ -102,7 +102,8 @@ const std::map<std::string, std::vector<std::string>>& key_table() {
        join_keys({kCommonMethodKeys, kFitKeys,
                   {"parameterization", "terms", "search_texture_size", "restarts", "guesses",
                    "reciprocity", "optimizer", "ftol", "line_tol", "initial_step", "max_sweeps",
-                   "max_evaluations", "threads", "seed"}})},
+                   "max_evaluations", "threads", "seed", "beam", "backfit_sweeps",
+                   "backfit_restarts"}})},
       {"method:svd", join_keys({kCommonMethodKeys,
                                 {"texture_size", "terms", "parameterization", "log", "eps",
                                  "subtract_eps", "rim_inset", "extend_below_horizon",
@@ -1284,6 +1285,9 @@ void read_method(Reader& r, Ctx& ctx, const std::string& kind, uint64_t base_see
     s.powell.max_sweeps = static_cast<int>(r.integer("max_sweeps", s.powell.max_sweeps, 1, 100000));
     s.powell.max_evaluations = static_cast<int>(r.integer("max_evaluations", s.powell.max_evaluations, 10, 100000000));
     s.threads = static_cast<int>(r.integer("threads", 0, 0, 1024));
+    s.beam = static_cast<int>(r.integer("beam", s.beam, 1, 100000));
+    s.backfit_sweeps = static_cast<int>(r.integer("backfit_sweeps", s.backfit_sweeps, 0, 1000));
+    s.backfit_restarts = static_cast<int>(r.integer("backfit_restarts", s.backfit_restarts, 0, 100000));
     m.seed = static_cast<uint64_t>(r.integer("seed", static_cast<int64_t>(base_seed), 0, kIntMax));
     read_fit_options(r, m.fit, o);
     if (s.restarts == 0 && s.guesses.empty() && !r.failed())
@@ -1308,6 +1312,10 @@ void read_method(Reader& r, Ctx& ctx, const std::string& kind, uint64_t base_see
     o["max_sweeps"] = s.powell.max_sweeps;
     o["max_evaluations"] = s.powell.max_evaluations;
     o["seed"] = m.seed;
+    // Non-greedy options enter the run id only when set, so greedy runs keep their cache.
+    if (s.beam != 1) o["beam"] = s.beam;
+    if (s.backfit_sweeps != 0) o["backfit_sweeps"] = s.backfit_sweeps;
+    if (s.backfit_sweeps != 0 && s.backfit_restarts != 0) o["backfit_restarts"] = s.backfit_restarts;
     m.execution["threads"] = s.threads;
     const int starts = s.restarts + static_cast<int>(s.guesses.size());
     m.cores = std::max(1, std::min(s.threads == 0 ? hardware_cores() : s.threads, starts));

@@ -150,7 +150,8 @@ std::string describe_method(const MethodVariant& m) {
   static const std::map<std::string, std::vector<std::string>> shown = {
       {"mccool", {"texture_size"}},
       {"fit", {"terms", "texture_size", "parameterization", "reciprocity"}},
-      {"search", {"parameterization", "terms", "texture_size", "reciprocity", "restarts", "optimizer", "seed"}},
+      {"search", {"parameterization", "terms", "texture_size", "reciprocity", "restarts", "optimizer",
+                  "beam", "backfit_sweeps", "seed"}},
       {"svd", {"terms", "texture_size", "parameterization", "log"}},
       {"sh-k", {"order", "texture_size"}},
       {"sh-r", {"order", "view_order"}},
@@ -301,8 +302,14 @@ RunEntry execute_run(const Plan& plan, const PlannedRun& pr, const SampleSet& sa
                        {"search_rel_mse", std::isfinite(t.search_rel_mse) ? json(t.search_rel_mse) : json()},
                        {"evaluations", t.evaluations},
                        {"seconds", t.seconds},
-                       {"best_start", t.best_start}});
+                       {"best_start", t.best_start},
+                       {"backfit_evaluations", t.backfit_evaluations},
+                       {"backfit_moves", t.backfit_moves}});
     rec["terms"] = terms;
+    if (sr.beam_rel_mse.size() > 1) {
+      rec["beam_rel_mse"] = sr.beam_rel_mse;
+      rec["best_branch"] = sr.best_branch;
+    }
   } else if (m.kind == "svd") {
     if (m.tolerance) choice = select_svd_rank(*b.brdf, samples, m.svd, *m.tolerance, m.cap);
     else f = fit_svd(*b.brdf, m.svd);

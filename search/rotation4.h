@@ -54,6 +54,9 @@ struct Rotation4 {
   Projection projection(Parameterization param, int res) const;
   // [S.w, S.x, S.y, S.z, T.w, T.x, T.y, T.z]
   std::array<double, 8> packed() const;
+  static Rotation4 from_packed(const std::array<double, 8>& p) {
+    return {Quat(p[0], p[1], p[2], p[3]), Quat(p[4], p[5], p[6], p[7])};
+  }
 };
 
 // A search direction prepared for the line R(t) = D^t R_s: D's two angles are

@@ -40,6 +40,16 @@ void SearchOptions::validate() const {
                                 "direct or crs, found \"" + optimizer + "\"");
   if (threads < 0)
     throw std::invalid_argument("threads: expected >= 0, found " + std::to_string(threads));
+  const int starts = restarts + static_cast<int>(guesses.size());
+  if (beam < 1 || beam > starts)
+    throw std::invalid_argument("beam: expected 1..(restarts + guesses) = 1.." +
+                                std::to_string(starts) + ", found " + std::to_string(beam));
+  if (backfit_sweeps < 0)
+    throw std::invalid_argument("backfit_sweeps: expected >= 0, found " +
+                                std::to_string(backfit_sweeps));
+  if (backfit_restarts < 0)
+    throw std::invalid_argument("backfit_restarts: expected >= 0, found " +
+                                std::to_string(backfit_restarts));
   fit.validate();
   powell.validate();
 }
@@ -74,10 +84,10 @@ struct StartResult {
 };
 
 // nlopt over the chart a -> (exp(a_0..2) S0, T0 exp(a_3..5)) around the start.
-StartResult nlopt_minimize(const TermObjective& f, const Rotation4& start,
+StartResult nlopt_minimize(const RotationObjective& f, const Rotation4& start,
                            const SearchOptions& opt) {
   struct Ctx {
-    const TermObjective* f;
+    const RotationObjective* f;
     Rotation4 s;
     int evals = 0;
   } ctx{&f, start, 0};
@@ -128,78 +138,266 @@ StartResult nlopt_minimize(const TermObjective& f, const Rotation4& start,
 
 }  // namespace
 
+namespace {
+
+// Minimizes f from every start, in parallel (results independent of scheduling).
+std::vector<StartResult> run_starts(const RotationObjective& f, const std::vector<Rotation4>& starts,
+                                    const SearchOptions& opt) {
+  const unsigned hw = std::max(1u, std::thread::hardware_concurrency());
+  const unsigned nthreads = opt.threads > 0 ? opt.threads : hw;
+  std::vector<StartResult> results(starts.size());
+  std::atomic<size_t> next{0};
+  auto worker = [&] {
+    for (size_t i = next++; i < starts.size(); i = next++) {
+      if (opt.optimizer == "powell") {
+        const PowellResult p = powell_minimize(f, starts[i], opt.powell);
+        results[i] = {p.best, p.value, p.evaluations};
+      } else {
+        results[i] = nlopt_minimize(f, starts[i], opt);
+      }
+    }
+  };
+  std::vector<std::thread> pool;
+  for (unsigned t = 1; t < std::min<unsigned>(nthreads, starts.size()); ++t) pool.emplace_back(worker);
+  worker();
+  for (auto& th : pool) th.join();
+  return results;
+}
+
+size_t first_joint(size_t step, int n) {  // terms first..step are solved jointly at step
+  return step + 1 > static_cast<size_t>(n) ? step + 1 - n : 0;
+}
+
+// One search path: the projections found so far and the schedule's texels at
+// the search resolution.
+struct Branch {
+  std::vector<Rotation4> rotations;
+  std::vector<TermSpec> specs;     // at the search resolution
+  std::vector<FactorTerm> done;    // schedule texels (last n re-solved at each step)
+  std::vector<TermRecord> records;
+  double value = std::numeric_limits<double>::infinity();
+  int evaluations = 0;
+};
+
+// Runs the fit schedule over b.specs (search objective) and sets done/value.
+void resolve_schedule(const FitData& data, const SearchOptions& opt, Branch& b) {
+  const int n = opt.fit.solve_last;
+  b.done.clear();
+  for (size_t s = 0; s < b.specs.size(); ++s) {
+    const size_t first = first_joint(s, n);
+    std::vector<FactorTerm> fixed(b.done.begin(), b.done.begin() + first);
+    std::vector<TermSpec> joint(b.specs.begin() + first, b.specs.begin() + s + 1);
+    const JointSolution sol = solve_joint(data, fixed_sum(data, fixed), joint, opt.fit, false);
+    b.done = fixed;
+    b.done.insert(b.done.end(), sol.terms.begin(), sol.terms.end());
+    b.value = sol.rel_mse;
+  }
+}
+
+// Adds term j to b: the objective given b's terms; best of the start results.
+void add_term(const FitData& data, const SearchOptions& opt, int sres, Branch& b,
+              const StartResult& best, int best_start, int evaluations, double t0) {
+  const int j = static_cast<int>(b.specs.size());
+  const size_t first = first_joint(j, opt.fit.solve_last);
+  std::vector<FactorTerm> fixed(b.done.begin(), b.done.begin() + first);
+  std::vector<TermSpec> joint(b.specs.begin() + first, b.specs.end());
+  const TermObjective objective(data, fixed, joint, opt, sres);
+  const Rotation4 R = best.best.normalized();
+  joint.push_back(objective.spec(R));
+  const JointSolution sol = solve_joint(data, objective.fixed_values(), joint, opt.fit, false);
+  b.done = fixed;
+  b.done.insert(b.done.end(), sol.terms.begin(), sol.terms.end());
+  b.specs.push_back(objective.spec(R));
+  b.rotations.push_back(R);
+  b.value = sol.rel_mse;
+  TermRecord rec;
+  rec.rotation = R.packed();
+  rec.search_rel_mse = best.value;
+  rec.evaluations = evaluations;
+  rec.best_start = best_start;
+  rec.seconds = now_seconds() - t0;
+  b.records.push_back(rec);
+  b.evaluations += evaluations;
+}
+
+// The starts of term j's search: seeded random rotations, then guesses.
+std::vector<Rotation4> term_starts(const SearchOptions& opt, int j) {
+  std::vector<Rotation4> starts;
+  for (int r = 0; r < opt.restarts; ++r) {
+    std::mt19937_64 rng(opt.seed * 1000003ull + static_cast<uint64_t>(j) * 7919ull + r);
+    starts.push_back(Rotation4::random(rng));
+  }
+  for (const auto& g : opt.guesses) starts.push_back(guess_rotation(g));
+  return starts;
+}
+
+// Searches term j of b greedily (all starts), returning every start's result.
+std::vector<StartResult> search_term(const FitData& data, const SearchOptions& opt, int sres,
+                                     const Branch& b) {
+  const int j = static_cast<int>(b.specs.size());
+  const size_t first = first_joint(j, opt.fit.solve_last);
+  std::vector<FactorTerm> fixed(b.done.begin(), b.done.begin() + first);
+  std::vector<TermSpec> known(b.specs.begin() + first, b.specs.end());
+  const TermObjective objective(data, fixed, known, opt, sres);
+  return run_starts(std::cref(objective), term_starts(opt, j), opt);
+}
+
+// Cyclic backfitting after the last term was added: each term re-searched
+// with the others held; a move is kept only if it lowers the objective.
+void backfit(const FitData& data, const SearchOptions& opt, int sres, Branch& b) {
+  const size_t J = b.specs.size();
+  if (opt.backfit_sweeps == 0 || J < 2) return;
+  const double tb = now_seconds();
+  for (int sweep = 0; sweep < opt.backfit_sweeps; ++sweep) {
+    bool moved = false;
+    for (size_t i = 0; i < J; ++i) {
+      const ScheduleObjective objective(data, b.specs, i, opt, sres);
+      std::vector<Rotation4> starts{b.rotations[i]};
+      for (int r = 0; r < opt.backfit_restarts; ++r) {
+        std::mt19937_64 rng(opt.seed * 1000003ull + 0x9e3779b97f4a7c15ull * (J * 131 + i + 1) +
+                            static_cast<uint64_t>(sweep) * 7919ull + r);
+        starts.push_back(Rotation4::random(rng));
+      }
+      const std::vector<StartResult> res = run_starts(std::cref(objective), starts, opt);
+      size_t best = 0;
+      for (size_t k = 0; k < res.size(); ++k) {
+        b.records.back().backfit_evaluations += res[k].evaluations;
+        b.evaluations += res[k].evaluations;
+        if (res[k].value < res[best].value) best = k;
+      }
+      // Keep the move only if the re-solved schedule is really lower (the
+      // candidate's value was summed in a different order: ulps).
+      if (res[best].value < b.value * (1 - 1e-12)) {
+        Branch moved_branch = b;
+        const Rotation4 R = res[best].best.normalized();
+        moved_branch.rotations[i] = R;
+        moved_branch.specs[i] = TermSpec{R.projection(opt.param, sres), opt.reciprocity, R.packed()};
+        moved_branch.records[i].rotation = R.packed();
+        resolve_schedule(data, opt, moved_branch);
+        if (moved_branch.value < b.value) {
+          b = std::move(moved_branch);
+          ++b.records.back().backfit_moves;
+          moved = true;
+        }
+      }
+    }
+    if (!moved) break;  // a sweep that changed nothing ends the cycle
+  }
+  b.records.back().search_rel_mse = b.value;
+  b.records.back().seconds += now_seconds() - tb;
+}
+
+}  // namespace
+
+ScheduleObjective::ScheduleObjective(const FitData& data, std::vector<TermSpec> specs,
+                                     size_t which, const SearchOptions& opt, int res)
+    : data_(data), specs_(std::move(specs)), which_(which), opt_(opt), res_(res) {
+  if (which_ >= specs_.size())
+    throw std::invalid_argument("backfit: term " + std::to_string(which_ + 1) + " of " +
+                                std::to_string(specs_.size()));
+  const int n = opt.fit.solve_last;
+  const size_t last = specs_.size() - 1;
+  first_step_ = std::max(which_, std::min(static_cast<size_t>(n - 1), last));
+  // Steps before first_step_ do not involve term `which`: solve them once.
+  std::vector<FactorTerm> done;
+  for (size_t s = 0; s < first_step_; ++s) {
+    const size_t first = first_joint(s, n);
+    std::vector<FactorTerm> fixed(done.begin(), done.begin() + first);
+    std::vector<TermSpec> joint(specs_.begin() + first, specs_.begin() + s + 1);
+    const JointSolution sol = solve_joint(data, fixed_sum(data, fixed), joint, opt.fit, false);
+    done = fixed;
+    done.insert(done.end(), sol.terms.begin(), sol.terms.end());
+  }
+  prefix_.assign(done.begin(), done.begin() + first_joint(first_step_, n));
+  prefix_values_ = fixed_sum(data, prefix_);
+}
+
+double ScheduleObjective::operator()(const Rotation4& r) const {
+  const Rotation4 rn = r.normalized();
+  std::vector<TermSpec> specs = specs_;
+  specs[which_] = TermSpec{rn.projection(opt_.param, res_), opt_.reciprocity, rn.packed()};
+  const int n = opt_.fit.solve_last;
+  try {
+    std::vector<FactorTerm> done = prefix_;
+    std::array<std::vector<double>, 3> values = prefix_values_;
+    size_t summed = prefix_.size();  // terms of `done` already in `values`
+    double value = 0;
+    for (size_t s = first_step_; s < specs.size(); ++s) {
+      const size_t first = first_joint(s, n);
+      if (first > summed) {
+        const std::vector<FactorTerm> add(done.begin() + summed, done.begin() + first);
+        const auto v = fixed_sum(data_, add);
+        for (int c = 0; c < 3; ++c)
+          for (size_t k = 0; k < v[c].size(); ++k) values[c][k] += v[c][k];
+        summed = first;
+      }
+      std::vector<TermSpec> joint(specs.begin() + first, specs.begin() + s + 1);
+      const JointSolution sol = solve_joint(data_, values, joint, opt_.fit, false);
+      done.resize(first);
+      done.insert(done.end(), sol.terms.begin(), sol.terms.end());
+      value = sol.rel_mse;
+    }
+    return value;
+  } catch (const std::runtime_error&) {
+    return std::numeric_limits<double>::max();
+  }
+}
+
 SearchResult search_factorization(const FitData& data, const SearchOptions& opt) {
   opt.validate();
   const double t0 = now_seconds();
   const int sres = opt.search_texture_size > 0 ? opt.search_texture_size : opt.texture_size;
-  const int n = opt.fit.solve_last;
-  const unsigned hw = std::max(1u, std::thread::hardware_concurrency());
-  const unsigned nthreads = opt.threads > 0 ? opt.threads : hw;
-
   SearchResult out;
-  std::vector<FactorTerm> done;    // terms at the search resolution, with texels
-  std::vector<TermSpec> found;     // projection specs found so far
-  std::vector<Rotation4> rotations;
-  for (int j = 0; j < opt.terms; ++j) {
-    const double tj = now_seconds();
-    const int first = std::max(0, j + 1 - n);  // terms first..j solved jointly
-    std::vector<FactorTerm> fixed(done.begin(), done.begin() + first);
-    std::vector<TermSpec> known(found.begin() + first, found.begin() + j);
-    const TermObjective objective(data, fixed, known, opt, sres);
 
-    // Starts: seeded random rotations, then guesses; each start has its own
-    // RNG stream so results do not depend on thread scheduling.
-    std::vector<Rotation4> starts;
-    for (int r = 0; r < opt.restarts; ++r) {
-      std::mt19937_64 rng(opt.seed * 1000003ull + static_cast<uint64_t>(j) * 7919ull + r);
-      starts.push_back(Rotation4::random(rng));
-    }
-    for (const auto& g : opt.guesses) starts.push_back(guess_rotation(g));
+  // Term 1: every start; the beam keeps the best `beam` of them (ties by index).
+  Branch root;
+  const double t1 = now_seconds();
+  const std::vector<StartResult> first = search_term(data, opt, sres, root);
+  int first_evals = 0;
+  for (const StartResult& r : first) first_evals += r.evaluations;
+  std::vector<size_t> order(first.size());
+  for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(),
+                   [&](size_t a, size_t b) { return first[a].value < first[b].value; });
+  out.evaluations += first_evals;
 
-    std::vector<StartResult> results(starts.size());
-    std::atomic<size_t> next{0};
-    auto worker = [&] {
-      for (size_t i = next++; i < starts.size(); i = next++) {
-        if (opt.optimizer == "powell") {
-          const PowellResult p = powell_minimize(objective, starts[i], opt.powell);
-          results[i] = {p.best, p.value, p.evaluations};
-        } else {
-          results[i] = nlopt_minimize(objective, starts[i], opt);
-        }
+  double best_error = std::numeric_limits<double>::infinity();
+  for (int k = 0; k < opt.beam; ++k) {
+    Branch b;
+    // The first term's search cost is shared by the branches: booked on branch 0.
+    add_term(data, opt, sres, b, first[order[k]], static_cast<int>(order[k]),
+             k == 0 ? first_evals : 0, t1);
+    for (int j = 1; j < opt.terms; ++j) {
+      backfit(data, opt, sres, b);
+      const double tj = now_seconds();
+      const std::vector<StartResult> res = search_term(data, opt, sres, b);
+      size_t best = 0;
+      int evals = 0;
+      for (size_t i = 0; i < res.size(); ++i) {
+        evals += res[i].evaluations;
+        if (res[i].value < res[best].value) best = i;
       }
-    };
-    std::vector<std::thread> pool;
-    for (unsigned t = 1; t < std::min<unsigned>(nthreads, starts.size()); ++t) pool.emplace_back(worker);
-    worker();
-    for (auto& th : pool) th.join();
-
-    size_t best = 0;
-    TermRecord rec;
-    for (size_t i = 0; i < results.size(); ++i) {
-      rec.evaluations += results[i].evaluations;
-      if (results[i].value < results[best].value) best = i;
+      add_term(data, opt, sres, b, res[best], static_cast<int>(best), evals, tj);
     }
-    const Rotation4 R = results[best].best.normalized();
-    rec.rotation = R.packed();
-    rec.search_rel_mse = results[best].value;
-    rec.best_start = static_cast<int>(best);
-    std::vector<TermSpec> joint = known;
-    joint.push_back(objective.spec(R));
-    const JointSolution sol = solve_joint(data, objective.fixed_values(), joint, opt.fit);
-    done = fixed;
-    done.insert(done.end(), sol.terms.begin(), sol.terms.end());
-    found.push_back(objective.spec(R));
-    rotations.push_back(R);
-    rec.seconds = now_seconds() - tj;
-    out.evaluations += rec.evaluations;
-    out.terms.push_back(rec);
-  }
+    backfit(data, opt, sres, b);
+    out.evaluations += b.evaluations - (k == 0 ? first_evals : 0);
 
-  // Refit the found projections at the final resolution (thesis 4.2).
-  std::vector<TermSpec> final_specs;
-  for (const Rotation4& R : rotations)
-    final_specs.push_back(TermSpec{R.projection(opt.param, opt.texture_size), opt.reciprocity, R.packed()});
-  out.factorization = fit_homomorphic(data, final_specs, opt.fit, "search", &out.rel_mse_after_term);
+    // Refit the found projections at the final resolution (thesis 4.2).
+    std::vector<TermSpec> final_specs;
+    for (const Rotation4& R : b.rotations)
+      final_specs.push_back(TermSpec{R.projection(opt.param, opt.texture_size), opt.reciprocity, R.packed()});
+    std::vector<double> errors;
+    auto f = fit_homomorphic(data, final_specs, opt.fit, "search", &errors);
+    out.beam_rel_mse.push_back(errors.back());
+    if (errors.back() < best_error) {
+      best_error = errors.back();
+      out.factorization = f;
+      out.rel_mse_after_term = errors;
+      out.terms = b.records;
+      out.search_rel_mse = b.value;
+      out.best_branch = k;
+    }
+  }
   out.seconds = now_seconds() - t0;
   return out;
 }

@@ -4,6 +4,19 @@
 // objective being the rel_mse of the homomorphic fit with the last n terms
 // solved jointly. Seeded random restarts run in parallel; the search runs at a
 // small texture and the found projections are refitted at the final size.
+//
+// Two non-greedy extensions (the greedy search traps itself: the best first
+// texture need not lead to the best pair):
+//  - beam = k: the k best first-term candidates (from different starts) are
+//    each continued to the end; the branch with the lowest final error (at the
+//    final texture size) wins. Branch 1 is the greedy search itself, so the
+//    result is never worse than greedy.
+//  - backfit_sweeps = s: after term j (j >= 2) is added, every term 1..j is
+//    re-searched in turn (cyclically, s sweeps) with the other projections
+//    held, from its current rotation (plus backfit_restarts random starts);
+//    the objective is the error of the whole fit schedule (thesis 3.2.2) with
+//    that one projection changed, so each accepted move lowers the search
+//    objective.
 #pragma once
 
 #include <memory>
@@ -30,6 +43,9 @@ struct SearchOptions {
   std::string optimizer = "powell";
   PowellOptions powell;                 // also: ftol and max_evaluations for nlopt
   int threads = 0;                      // restarts in parallel; 0 = hardware threads
+  int beam = 1;                         // first-term candidates continued; 1 = greedy
+  int backfit_sweeps = 0;               // cyclic re-search sweeps after each added term
+  int backfit_restarts = 0;             // random starts per re-search besides the current rotation
   void validate() const;                // throws naming the field, value and rule
 };
 
@@ -39,13 +55,18 @@ struct TermRecord {
   int evaluations = 0;             // inner-loop fits for this term (all starts)
   double seconds = 0;
   int best_start = 0;              // index of the winning start (restarts first, then guesses)
+  int backfit_evaluations = 0;     // fits spent re-searching terms 1..j after this term was added
+  int backfit_moves = 0;           // re-searches that lowered the objective
 };
 
 struct SearchResult {
   std::shared_ptr<HomomorphicFactorization> factorization;  // at texture_size
   std::vector<TermRecord> terms;
   std::vector<double> rel_mse_after_term;  // at texture_size, fit data
-  int evaluations = 0;
+  double search_rel_mse = 0;               // final objective at the search resolution
+  std::vector<double> beam_rel_mse;        // final error (texture_size) of each beam branch
+  int best_branch = 0;                     // the winning branch (0 = the greedy one)
+  int evaluations = 0;                     // all inner-loop fits (all branches, backfitting)
   double seconds = 0;
 };
 
@@ -66,6 +87,26 @@ class TermObjective {
   const FitData& data_;
   std::array<std::vector<double>, 3> fixed_values_;
   std::vector<TermSpec> joint_known_;
+  const SearchOptions& opt_;
+  int res_;
+};
+
+// The objective of backfitting: the search-objective error of the whole fit
+// schedule (terms 1..J = specs, last n joint, thesis 3.2.2) when term `which`
+// is read through a candidate rotation and the others are held. Steps that do
+// not depend on term `which` are solved once, in the constructor.
+class ScheduleObjective {
+ public:
+  ScheduleObjective(const FitData& data, std::vector<TermSpec> specs, size_t which,
+                    const SearchOptions& opt, int res);
+  double operator()(const Rotation4& r) const;
+
+ private:
+  const FitData& data_;
+  std::vector<TermSpec> specs_;
+  size_t which_, first_step_;
+  std::vector<FactorTerm> prefix_;                  // terms fixed before first_step_
+  std::array<std::vector<double>, 3> prefix_values_;
   const SearchOptions& opt_;
   int res_;
 };

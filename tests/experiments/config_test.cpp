@@ -381,3 +381,19 @@ TEST_CASE("config: the CLI prints one line per problem and exits 2") {
   CHECK(out.find("brdf-factor: " + cfg + ":13: method[0].restrats: unknown key") != std::string::npos);
   CHECK(!fs::exists(tmp / "out"));  // nothing written
 }
+
+TEST_CASE("config: non-greedy search keys (beam, backfit) are read, validated, and keep greedy run ids") {
+  const std::string greedy = std::string(kBase) + "[[method]]\nkind = \"search\"\nrestarts = 3\n";
+  const Plan g = plan_of(greedy);
+  const Plan g1 = plan_of(greedy + "beam = 1\nbackfit_sweeps = 0\n");
+  CHECK(g.runs[0].run_id == g1.runs[0].run_id);  // defaults do not change the id (cache kept)
+  const Plan p = plan_of(greedy + "beam = 2\nbackfit_sweeps = [0, 3]\nbackfit_restarts = 1\n");
+  REQUIRE(p.methods.size() == 2);
+  CHECK(p.methods[0].search.beam == 2);
+  CHECK(p.methods[1].search.backfit_sweeps == 3);
+  CHECK(p.methods[1].search.backfit_restarts == 1);
+  CHECK(p.runs[0].run_id != g.runs[0].run_id);
+  CHECK(p.runs[0].run_id != p.runs[1].run_id);
+  require_one(greedy + "beam = 4\n", {"cfg.toml:", "method[0]", "beam", "1..3", "found 4"});
+  require_one(greedy + "backfit_sweeps = -1\n", {"cfg.toml:", "method[0].backfit_sweeps", "found -1"});
+}
