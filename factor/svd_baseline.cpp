@@ -81,11 +81,15 @@ void SvdOptions::validate() const {
   if (rank < 1) throw std::invalid_argument("svd: terms: expected >= 1, found " + std::to_string(rank));
   if (!(eps > 0.0 && eps <= 1.0))
     throw std::invalid_argument("svd: eps: expected 0 < eps <= 1, found " + std::to_string(eps));
-  if (!(rim_inset > 0.0 && rim_inset <= 0.1))
-    throw std::invalid_argument("svd: rim_inset: expected 0 < rim_inset <= 0.1, found " +
+  if (!(rim_inset >= 0.0 && rim_inset <= 0.5))
+    throw std::invalid_argument("svd: rim_inset: expected 0 (half a texel) or 0 < rim_inset <= 0.5, found " +
                                 std::to_string(rim_inset));
   if (subtract_eps && !log)
     throw std::invalid_argument("svd: subtract_eps applies only to the log-space SVD (log = true)");
+}
+
+double SvdOptions::effective_rim_inset() const {
+  return rim_inset > 0.0 ? rim_inset : std::min(0.5, 1.0 / std::max(1, res - 1));
 }
 
 // ---------------------------------------------------------------- tabulation
@@ -102,12 +106,13 @@ SvdTable tabulate_svd(const Brdf& brdf, const SvdOptions& opt) {
   for (auto& M : t.M) M.resize(n, n);
   std::vector<Vec3> dir(n);
   std::vector<uint8_t> inside(n);
+  const double inset = opt.effective_rim_inset();
   for (int k = 0; k < n; ++k) {
-    dir[k] = t.grid.direction(t.grid.texels[k], opt.rim_inset);
+    dir[k] = t.grid.direction(t.grid.texels[k], inset);
     inside[k] = t.grid.point(t.grid.texels[k]).norm() <= 1.0 + 1e-12;
   }
   // The lowest elevation a texel direction has (the pulled-in rim).
-  const double rr = 1.0 - opt.rim_inset, z_min = (1.0 - rr * rr) / (1.0 + rr * rr);
+  const double rr = 1.0 - inset, z_min = (1.0 - rr * rr) / (1.0 + rr * rr);
   // Columns in parallel; each chunk keeps its own sums for A.
   Rgb sum = Rgb::Zero();
   double count = 0;
@@ -276,7 +281,7 @@ nlohmann::json SvdFactorization::describe() const {
   j["resolution"] = grid_.res;
   j["texel_coords"] = "s = (p + 1) / 2 * (resolution - 1); texel (i, j) at s = (i, j), index j * resolution + i";
   j["texels_per_texture"] = grid_.count();
-  j["rim_inset"] = opt_.rim_inset;
+  j["rim_inset"] = opt_.effective_rim_inset();
   if (opt_.param == Parameterization::HalfDiff) j["extend_below_horizon"] = opt_.extend_below_horizon;
   j["rank"] = rank_;
   j["log"] = opt_.log;
@@ -371,6 +376,48 @@ SizeChoice select_svd_rank(const Brdf& brdf, const SampleSet& samples, const Svd
   }
   ch.seconds = seconds_since(t0);
   return ch;
+}
+
+const std::vector<int>& default_texture_ladder() {
+  static const std::vector<int> ladder = {8, 12, 16, 24, 32};
+  return ladder;
+}
+
+void validate_texture_ladder(const std::vector<int>& ladder, int lo, int hi, const std::string& what) {
+  if (ladder.empty()) throw std::invalid_argument(what + ": expected a non-empty list of resolutions, found []");
+  for (size_t i = 0; i < ladder.size(); ++i) {
+    if (ladder[i] < lo || ladder[i] > hi)
+      throw std::invalid_argument(what + ": expected resolutions in " + std::to_string(lo) + ".." +
+                                  std::to_string(hi) + ", found " + std::to_string(ladder[i]));
+    if (i > 0 && ladder[i] <= ladder[i - 1])
+      throw std::invalid_argument(what + ": expected strictly ascending resolutions, found " +
+                                  std::to_string(ladder[i]) + " after " + std::to_string(ladder[i - 1]));
+  }
+}
+
+SizeChoice select_svd_size(const Brdf& brdf, const SampleSet& samples, const SvdOptions& base,
+                           const Tolerance& tol, int max_rank, const std::vector<int>& ladder) {
+  validate_texture_ladder(ladder, 2, 256, "svd: texture_ladder");
+  tol.validate();
+  const auto t0 = std::chrono::steady_clock::now();
+  SizeChoice best;
+  best.error = std::numeric_limits<double>::infinity();
+  std::vector<SizeTrial> tried;
+  for (int res : ladder) {
+    SvdOptions o = base;
+    o.res = res;
+    SizeChoice c = select_svd_rank(brdf, samples, o, tol, max_rank);
+    for (SizeTrial t : c.tried) {
+      t.texture_size = res;
+      tried.push_back(t);
+    }
+    c.texture_size = res;
+    if (c.reached || !best.result || c.error < best.error) best = std::move(c);
+    if (best.reached) break;
+  }
+  best.tried = std::move(tried);
+  best.seconds = seconds_since(t0);
+  return best;
 }
 
 }  // namespace bf

@@ -31,9 +31,9 @@ namespace bf {
 // lookups of points in the disk can read). A texel is evaluated at the
 // direction of its point pulled in to radius 1 - rim_inset when it lies
 // further out: texels on or outside the disk edge take the BRDF's value at
-// the grazing direction of the same azimuth (theta ~ 89.99 deg for the default
-// inset), a continuous extension; a direction exactly on the horizon would
-// read 0 from every BRDF.
+// the direction of the same azimuth at radius 1 - rim_inset (SVD default:
+// half a grid spacing in, see SvdOptions::rim_inset), a continuous
+// extension; a direction exactly on the horizon would read 0 from every BRDF.
 struct DiskGrid {
   int res = 0;
   std::vector<int> texels;  // masked texel indices, ascending
@@ -57,7 +57,18 @@ struct SvdOptions {
   bool log = false;         // decompose g = log((f + eps A)/A) instead of f
   double eps = 1e-5;        // log-space bias (DESIGN.md §2), 0 < eps <= 1
   bool subtract_eps = false;  // log reconstruction A exp(.) - eps A (else A exp(.)); Cole omits it
-  double rim_inset = 1e-4;  // DiskGrid: texels beyond radius 1 - rim_inset are pulled in; (0, 0.1]
+  // DiskGrid: texels beyond radius 1 - rim_inset are evaluated at that radius.
+  // 0 (default) = half the grid spacing, 1/(res-1): the rim texel takes the
+  // BRDF's value in the middle of the outermost ring of cells, the region its
+  // bilinear footprint covers inside the disk. A tiny inset (the old 1e-4,
+  // theta 89.99 deg) tabulates the BRDF at grazing angles no sample set
+  // reaches, where models with 1/(cos_i cos_o) (Cook-Torrance) are ~1e7: the
+  // linear SVD then spends its terms on those texels and bilinear lookups
+  // spread them over the outer cells (cole-cook-torrance, 16x16, rank 4:
+  // lin_max ~5e4 for a BRDF peaking ~140 on the samples). [0, 0.5]
+  double rim_inset = 0.0;
+  // The inset in use: rim_inset, or 1/(res-1) (at most 0.5) when it is 0.
+  double effective_rim_inset() const;
   // halfdiff only: texel pairs (h, d) whose wi or wo falls below the horizon
   // are no BRDF configuration; bilinear lookups near the horizon still read
   // them. true: fill them with the BRDF at wi, wo lifted to the rim elevation
@@ -170,6 +181,7 @@ struct SizeTrial {
   int value = 0;        // rank K or order F
   int view_order = -1;  // SH-R: view order P; -1 otherwise
   double error = 0;     // the tolerance metric
+  int texture_size = 0; // resolution of the trial when it is chosen too (select_*_size); 0 otherwise
 };
 
 // What a selection chose, with its error and time (a row of a report).
@@ -178,13 +190,21 @@ struct SizeChoice {
   std::string knob;     // "terms" (SVD rank) or "order" (SH band limit F)
   int value = 0;        // the chosen rank / order
   int view_order = -1;  // SH-R: the chosen view order P; -1 otherwise
+  int texture_size = 0; // the chosen resolution (select_*_size); 0 when the resolution was fixed
   std::string metric;   // tolerance metric
   double error = 0;     // metric at the choice
   bool reached = false; // error <= tolerance; false: nothing up to the cap reached it, value is the best tried
   double seconds = 0;   // wall time: tabulation/projection + decompositions + scoring
   std::vector<SizeTrial> tried;  // in the order scored
   FactorizationPtr result;       // the chosen approximation
+  std::vector<double> errors_after_term;  // homomorphic: rel_mse after each term of the chosen fit
 };
+
+// The resolutions tried when texture_size = "auto": 8, 12, 16, 24, 32.
+const std::vector<int>& default_texture_ladder();
+// Throws std::invalid_argument unless ladder is non-empty, strictly
+// ascending and every entry lies in lo..hi; `what` names the field.
+void validate_texture_ladder(const std::vector<int>& ladder, int lo, int hi, const std::string& what);
 
 // Smallest rank K <= max_rank whose SVD approximation scores <= tol on
 // `samples` (metrics of factor/metrics.h, log transform from the samples).
@@ -192,5 +212,14 @@ struct SizeChoice {
 // base.rank is ignored.
 SizeChoice select_svd_rank(const Brdf& brdf, const SampleSet& samples, const SvdOptions& base,
                            const Tolerance& tol, int max_rank);
+
+// Resolution and rank from one tolerance: the smallest resolution of `ladder`
+// (ascending) at which some rank <= max_rank reaches tol, with the smallest
+// such rank there (select_svd_rank per resolution, stopping at the first
+// resolution that reaches). Nothing reaches: the lowest error tried,
+// reached = false. tried lists every (resolution, rank) scored; seconds is
+// the wall time of the whole selection. base.res and base.rank are ignored.
+SizeChoice select_svd_size(const Brdf& brdf, const SampleSet& samples, const SvdOptions& base,
+                           const Tolerance& tol, int max_rank, const std::vector<int>& ladder);
 
 }  // namespace bf

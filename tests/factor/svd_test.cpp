@@ -92,8 +92,9 @@ TEST_CASE("svd: eval at grid nodes reads the rank-K matrix (texel plumbing)") {
     for (size_t r = 0; r < g.count(); r += 3)
       for (size_t c = 0; c < g.count(); c += 5) {
         // Interior nodes only (rim texels are evaluated at pulled-in points).
-        if (g.point(g.texels[r]).norm() > 0.95 || g.point(g.texels[c]).norm() > 0.95) continue;
-        Vec3 wi = g.direction(g.texels[r], opt.rim_inset), wo = g.direction(g.texels[c], opt.rim_inset);
+        const double rmax = 1.0 - opt.effective_rim_inset();
+        if (g.point(g.texels[r]).norm() > rmax || g.point(g.texels[c]).norm() > rmax) continue;
+        Vec3 wi = g.direction(g.texels[r], opt.effective_rim_inset()), wo = g.direction(g.texels[c], opt.effective_rim_inset());
         if (param == Parameterization::HalfDiff) {
           const Vec3 h = wi, d = wo;
           half_diff_inverse(h, d, wi, wo);
@@ -118,8 +119,9 @@ TEST_CASE("svd: a separable BRDF is reproduced at rank 1 at the grid nodes") {
   double worst = 0.0;
   for (int r : g.texels)
     for (int c : g.texels) {
-      if (g.point(r).norm() > 1.0 || g.point(c).norm() > 1.0) continue;
-      const Vec3 wi = g.direction(r, opt.rim_inset), wo = g.direction(c, opt.rim_inset);
+      const double rmax = 1.0 - opt.effective_rim_inset();  // rim nodes read pulled-in values
+      if (g.point(r).norm() > rmax || g.point(c).norm() > rmax) continue;
+      const Vec3 wi = g.direction(r, opt.effective_rim_inset()), wo = g.direction(c, opt.effective_rim_inset());
       const Rgb exact = brdf.eval(wi, wo), got = f->eval(wi, wo);
       worst = std::max(worst, ((got - exact).abs() / exact.abs().max(1e-300)).maxCoeff());
     }
@@ -255,4 +257,53 @@ TEST_CASE("svd: halfdiff pairs below the horizon are extended, not zeroed") {
   }
   INFO("rel_mse zero fill " << err[0] << ", extended " << err[1]);
   CHECK(err[1] < 0.5 * err[0]);
+}
+
+TEST_CASE("svd: Cook-Torrance stays bounded at the rim (grazing texels, issue #7)") {
+  // cole-cook-torrance: F D G / (4 cos_i cos_o) reaches ~1e7 at theta 89.99 deg
+  // in the mirror configuration. Rim texels tabulated there (the old inset
+  // 1e-4) made the linear SVD reproduce that spike and bilinear lookups spread
+  // it over the outer cells: lin_max ~5e4 for a BRDF peaking ~140 on the
+  // samples. Rim texels now take the value half a texel in.
+  CookTorranceParams cp;
+  cp.kd = Rgb::Constant(0.1);
+  cp.ks = Rgb::Constant(0.9);
+  cp.m = 0.3;
+  cp.f0 = Rgb::Constant(0.1);
+  const CookTorrance brdf(cp);
+  const SampleSet s = sample_stratified(brdf, 4000, 5);
+  const LogTransform lt = LogTransform::of(s);
+  double fmax = 0.0;
+  for (size_t k = 0; k < s.size(); ++k)
+    if (s.valid[k]) fmax = std::max(fmax, s.value[k].maxCoeff());
+  const auto approx_max = [&](const SvdFactorization& f) {
+    double m = 0.0;
+    for (size_t k = 0; k < s.size(); ++k)
+      if (s.valid[k]) m = std::max(m, f.eval(s.wi[k], s.wo[k]).abs().maxCoeff());
+    return m;
+  };
+  for (auto param : {Parameterization::WiWo, Parameterization::HalfDiff})
+    for (bool log : {false, true}) {
+      SvdOptions opt;
+      opt.param = param;
+      opt.res = 12;
+      opt.rank = 4;
+      opt.log = log;
+      const auto f = fit_svd(brdf, opt);
+      const double amax = approx_max(*f);
+      const double rel = evaluate_metrics(*f, s, lt).rel_mse;
+      INFO(to_string(param) << (log ? " log" : " linear") << ": max |approx| " << amax << ", BRDF max " << fmax
+                            << ", rel_mse " << rel);
+      CHECK(amax <= 2.0 * fmax);
+      CHECK(std::isfinite(rel));
+      if (!log) {
+        // The mechanism: the old inset tabulates the grazing spike.
+        opt.rim_inset = 1e-4;
+        const auto old = fit_svd(brdf, opt);
+        const double old_max = approx_max(*old), old_rel = evaluate_metrics(*old, s, lt).rel_mse;
+        INFO("rim_inset 1e-4: max |approx| " << old_max << ", rel_mse " << old_rel);
+        CHECK(old_max > 10.0 * fmax);
+        CHECK(rel < 0.5 * old_rel);
+      }
+    }
 }
