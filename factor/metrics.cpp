@@ -1,7 +1,9 @@
 // Error metrics (see metrics.h).
 #include "factor/metrics.h"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 namespace bf {
@@ -30,42 +32,62 @@ LogTransform LogTransform::of(const SampleSet& s, double eps) {
   return t;
 }
 
+namespace {
+
+// Sums run in long double: on x86-64 (80-bit) and on AArch64 (quad) its
+// exponent range holds the square of any double, so neither a 1e200-scaled BRDF
+// (errors^2 ~ 1e400) overflows nor a 1e-300-scaled one (errors^2 ~ 1e-600)
+// underflows to 0; the results are rounded back to double.
+using Acc = long double;
+static_assert(std::numeric_limits<Acc>::max_exponent >= 2 * std::numeric_limits<double>::max_exponent &&
+                  std::numeric_limits<Acc>::min_exponent - std::numeric_limits<Acc>::digits <=
+                      2 * (std::numeric_limits<double>::min_exponent - std::numeric_limits<double>::digits),
+              "metrics need a long double whose range holds the square of every double");
+
+constexpr double kBad = 1e300;  // error charged for a non-finite approximation value; cap of every metric
+
+double capped(Acc x) { return x < Acc(kBad) ? double(x) : kBad; }
+
+}  // namespace
+
 Metrics evaluate_metrics(const Brdf& approx, const SampleSet& s, const LogTransform& t) {
-  constexpr double kBad = 1e300;
-  double W = 0, rel_se = 0, rel_ae = 0, lin_se = 0, lin_ae = 0, cos_se = 0;
+  Acc W = 0, rel_se = 0, rel_ae = 0, lin_se = 0, lin_ae = 0, cos_se = 0, rel_max = 0, lin_max = 0;
   Metrics m;
   for (size_t k = 0; k < s.size(); ++k) {
     if (!s.valid[k]) continue;
-    const double w = s.weight_of(k);
+    const Acc w = s.weight_of(k);
     const Rgb fa = approx.eval(s.wi[k], s.wo[k]);
     ++m.samples;
-    W += 3.0 * w;
+    W += 3 * w;
     for (int c = 0; c < 3; ++c) {
       const double f = s.value[k][c];
-      double dg, df;
+      Acc dg, df, dc;
       if (std::isfinite(fa[c])) {
-        dg = t.g(c, fa[c]) - t.g(c, f);
-        df = fa[c] - f;
+        dg = Acc(t.g(c, fa[c])) - Acc(t.g(c, f));
+        df = Acc(fa[c]) - Acc(f);  // exact for doubles of similar size, never overflows
+        dc = df * Acc(s.wi[k].z());
+        if (!std::isfinite(dg)) dg = kBad;  // log of 0 where eps * A underflows
       } else {
-        dg = df = kBad;
+        dg = df = dc = kBad;
       }
-      const double dc = std::isfinite(fa[c]) ? df * s.wi[k].z() : kBad;
-      rel_se += w * std::min(dg * dg, kBad);
+      rel_se += w * dg * dg;
       rel_ae += w * std::abs(dg);
-      m.rel_max = std::max(m.rel_max, std::abs(dg));
-      lin_se += w * std::min(df * df, kBad);
+      rel_max = std::max(rel_max, std::abs(dg));
+      lin_se += w * df * df;
       lin_ae += w * std::abs(df);
-      m.lin_max = std::max(m.lin_max, std::abs(df));
-      cos_se += w * std::min(dc * dc, kBad);
+      lin_max = std::max(lin_max, std::abs(df));
+      cos_se += w * dc * dc;
     }
   }
   if (m.samples == 0) throw std::invalid_argument("metrics: the sample set has no valid sample");
-  if (!(W > 0.0)) throw std::invalid_argument("metrics: the sample weights sum to 0");
-  m.rel_mse = rel_se / W;
-  m.rel_mae = rel_ae / W;
-  m.lin_rmse = std::sqrt(lin_se / W);
-  m.lin_mae = lin_ae / W;
-  m.cos_rmse = std::sqrt(cos_se / W);
+  if (!(W > 0)) throw std::invalid_argument("metrics: the sample weights sum to 0");
+  m.rel_mse = capped(rel_se / W);
+  m.rel_mae = capped(rel_ae / W);
+  m.rel_max = capped(rel_max);
+  m.lin_rmse = capped(std::sqrt(lin_se / W));
+  m.lin_mae = capped(lin_ae / W);
+  m.lin_max = capped(lin_max);
+  m.cos_rmse = capped(std::sqrt(cos_se / W));
   return m;
 }
 

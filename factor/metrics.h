@@ -28,9 +28,11 @@ struct Metrics {
 };
 
 // Scores approx against the valid samples of s (weights w_k from s, 1 if none),
-// over the three channels. Non-finite approximation values count as an error of
-// 1e300 in every metric (never NaN). Throws if s has no valid sample or the
-// weights sum to 0.
+// over the three channels. Sums are in long double, so the metrics of a BRDF
+// scaled by 1e200 or 1e-300 are the scaled metrics (no overflow to the cap, no
+// underflow to 0). Non-finite approximation values count as an error of 1e300
+// and every metric is capped at 1e300 (never NaN or Inf). Throws if s has no
+// valid sample or the weights sum to 0.
 Metrics evaluate_metrics(const Brdf& approx, const SampleSet& s, const LogTransform& t);
 
 // The metric named `name` ("rel_mse", ..., "cos_rmse"); throws for unknown names.
