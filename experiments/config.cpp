@@ -77,6 +77,8 @@ namespace {
 const std::vector<std::string> kCommonMethodKeys = {"kind", "label", "refine", "zip"};
 const std::vector<std::string> kFitKeys = {"texture_size", "smoothing", "eps", "subtract_eps",
                                            "solve_last", "solver"};
+// Keys of the refinement stage (factor/refine.h) of the homomorphic kinds.
+const std::vector<std::string> kRefineKeys = {"refine_blend", "refine_iterations", "refine_smoothing"};
 
 std::vector<std::string> join_keys(std::initializer_list<std::vector<std::string>> parts) {
   std::vector<std::string> out;
@@ -94,12 +96,12 @@ const std::map<std::string, std::vector<std::string>>& key_table() {
       {"brdf", {"preset", "model", "file", "name", "zip"}},
       {"projection", {"parameterization", "matrix", "name", "reciprocal"}},
       {"tolerance", {"metric", "value"}},
-      {"method:mccool", join_keys({kCommonMethodKeys, kFitKeys, {"terms"}})},
-      {"method:fit", join_keys({kCommonMethodKeys, kFitKeys,
+      {"method:mccool", join_keys({kCommonMethodKeys, kFitKeys, kRefineKeys, {"terms"}})},
+      {"method:fit", join_keys({kCommonMethodKeys, kFitKeys, kRefineKeys,
                                 {"projections", "terms", "parameterization", "reciprocity",
                                  "tolerance"}})},
       {"method:search",
-       join_keys({kCommonMethodKeys, kFitKeys,
+       join_keys({kCommonMethodKeys, kFitKeys, kRefineKeys,
                   {"parameterization", "terms", "search_texture_size", "restarts", "guesses",
                    "reciprocity", "optimizer", "ftol", "line_tol", "initial_step", "max_sweeps",
                    "max_evaluations", "threads", "seed", "beam", "backfit_sweeps",
@@ -115,11 +117,14 @@ const std::map<std::string, std::vector<std::string>>& key_table() {
                                  {"order", "view_order", "max_order", "max_view_order",
                                   "energy_eps", "theta_i_nodes", "theta_o_nodes", "phi_nodes",
                                   "min_cos", "tolerance"}})},
+      {"method:model-fit", join_keys({kCommonMethodKeys,
+                                      {"model", "metric", "cube_root", "anisotropic", "lobes", "eps",
+                                       "starts", "seed", "max_iterations", "threads"}})},
   };
   return t;
 }
 
-const std::vector<std::string> kMethodKinds = {"mccool", "fit", "search", "svd", "sh-k", "sh-r"};
+const std::vector<std::string> kMethodKinds = {"mccool", "fit", "search", "svd", "sh-k", "sh-r", "model-fit"};
 const std::vector<std::string> kSamplingKinds = {"grid", "stratified", "file", "measured"};
 
 bool contains(const std::vector<std::string>& v, const std::string& s) {
@@ -1210,10 +1215,29 @@ void read_method(Reader& r, Ctx& ctx, const std::string& kind, uint64_t base_see
   m.kind = kind;
   m.label = r.text("label", kind);
   const std::string refine = r.choice("refine", "none", {"none", "linear", "cosine", "blend"});
-  if (refine != "none")
-    r.fail("refine", "refine = \"" + refine +
-                         "\" is not implemented yet (only \"none\" is; the nonlinear refinement stage is planned)");
+  const bool homomorphic = kind == "mccool" || kind == "fit" || kind == "search";
+  if (refine != "none" && !homomorphic)
+    r.fail("refine", "refine = \"" + refine + "\" applies to the homomorphic kinds (mccool, fit, search) only; kind = \"" +
+                         kind + "\" needs refine = \"none\"");
+  m.refine = refine;
   o["refine"] = refine;
+  if (homomorphic) {
+    // Read whatever refine is (so that a sweep over refine may carry them), but
+    // hashed only when a refinement runs: refine = "none" runs stay identical.
+    RefineOptions& ro = m.refine_options;
+    ro.objective = refine == "none" ? ro.objective : refine;
+    ro.blend_weight = r.number("refine_blend", ro.blend_weight, 0.0, kInf);
+    ro.max_iterations = static_cast<int>(r.integer("refine_iterations", ro.max_iterations, 1, 100000));
+    const bool own_smoothing = r.has("refine_smoothing");
+    ro.smoothing = r.number("refine_smoothing", ro.smoothing, 0.0, kInf);
+    if (refine != "none") {
+      if (refine == "blend") o["refine_blend"] = ro.blend_weight;
+      o["refine_iterations"] = ro.max_iterations;
+      // Default: the fit's own smoothing (filled in below, once it is read).
+      o["refine_smoothing"] = own_smoothing ? json(ro.smoothing) : json();
+    }
+    if (!own_smoothing) ro.smoothing = -1;  // = the fit's smoothing
+  }
   const auto cap_terms = [&](int def_cap) {
     if (m.tolerance) {
       m.cap = m.terms;
@@ -1398,6 +1422,44 @@ void read_method(Reader& r, Ctx& ctx, const std::string& kind, uint64_t base_see
         r.fail_table(e.what());
       }
     }
+  } else if (kind == "model-fit") {
+    ModelFitOptions& f = m.model_fit;
+    f.model = r.text("model", f.model);
+    f.metric = r.choice("metric", f.metric, {"cosine", "log"});
+    f.cube_root = r.boolean("cube_root", f.cube_root);
+    if (f.cube_root && f.metric != "cosine")
+      r.fail("cube_root", "cube_root = true applies to metric = \"cosine\" only, found metric = \"" + f.metric + "\"");
+    f.anisotropic = r.boolean("anisotropic", f.anisotropic);
+    f.lobes = static_cast<int>(r.integer("lobes", f.lobes, 1, 3));
+    f.eps = r.number("eps", f.eps, 0.0, 1.0, true);
+    f.starts = static_cast<int>(r.integer("starts", f.starts, 1, 1000));
+    m.seed = static_cast<uint64_t>(r.integer("seed", static_cast<int64_t>(base_seed), 0, kIntMax));
+    f.seed = m.seed;
+    f.max_iterations = static_cast<int>(r.integer("max_iterations", f.max_iterations, 1, 100000));
+    f.threads = static_cast<int>(r.integer("threads", 0, 0, 1024));
+    o["model"] = f.model;
+    o["metric"] = f.metric;
+    o["cube_root"] = f.cube_root;
+    o["anisotropic"] = f.anisotropic;
+    o["lobes"] = f.lobes;
+    o["eps"] = f.eps;
+    o["starts"] = f.starts;
+    o["seed"] = f.seed;
+    o["max_iterations"] = f.max_iterations;
+    m.execution["threads"] = f.threads;
+    m.cores = std::max(1, f.threads == 0 ? hardware_cores() : f.threads);
+    if (!r.failed()) {
+      try {
+        m.terms = static_cast<int>(check_model_fit(f));
+      } catch (const std::exception& e) {
+        const std::string msg = e.what();
+        // Messages start with the option's name ("model: ...", "lobes: ...").
+        const size_t colon = msg.find(':');
+        const std::string key = colon == std::string::npos ? "model" : msg.substr(0, colon);
+        if (contains(config_keys("method:model-fit"), key)) r.fail(key, msg.substr(colon + 2));
+        else r.fail("model", msg);
+      }
+    }
   } else if (kind == "sh-r") {
     ShrOptions& s = m.shr;
     m.tolerance = read_tolerance(r, ctx);
@@ -1450,6 +1512,19 @@ void read_method(Reader& r, Ctx& ctx, const std::string& kind, uint64_t base_see
       m.fit.validate();
     } catch (const std::exception& e) {
       r.fail_table(e.what());
+    }
+  }
+  if (homomorphic) {
+    RefineOptions& ro = m.refine_options;
+    if (ro.smoothing < 0) ro.smoothing = m.fit.smoothing;
+    if (refine != "none") o["refine_smoothing"] = ro.smoothing;
+    ro.threads = 1;
+    if (!r.failed()) {
+      try {
+        ro.validate();
+      } catch (const std::exception& e) {
+        r.fail_table(std::string("refinement: ") + e.what());
+      }
     }
   }
   r.finish(config_keys("method:" + kind), "kind = \"" + kind + "\"", nullptr);

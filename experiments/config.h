@@ -13,6 +13,8 @@
 
 #include "brdfs/brdf.h"
 #include "factor/homomorphic_fit.h"
+#include "factor/model_fit.h"
+#include "factor/refine.h"
 #include "factor/sh_baseline.h"
 #include "factor/svd_baseline.h"
 #include "search/term_search.h"
@@ -76,7 +78,7 @@ struct SamplingVariant {
 };
 
 struct MethodVariant {
-  std::string kind;         // "mccool" | "fit" | "search" | "svd" | "sh-k" | "sh-r"
+  std::string kind;         // "mccool" | "fit" | "search" | "svd" | "sh-k" | "sh-r" | "model-fit"
   std::string label;        // `label` key, default the kind
   std::string where;        // "file:line" of its [[method]] table
   nlohmann::json options;   // every effective option with its default filled in (hashed)
@@ -93,6 +95,12 @@ struct MethodVariant {
   ShkOptions shk;
   ShrOptions shr;
   std::optional<Tolerance> tolerance;  // fit, svd, sh-k, sh-r
+  // mccool, fit, search: "none" | "linear" | "cosine" | "blend" (factor/refine.h),
+  // the refinement stage run after the fit (refine_blend, refine_iterations,
+  // refine_smoothing fill refine_options).
+  std::string refine = "none";
+  RefineOptions refine_options;
+  ModelFitOptions model_fit;           // model-fit
   int cap = 0;              // with a tolerance: the largest terms / order tried
   uint64_t seed = 0;        // search seed (0 when the kind has none)
   int cores = 1;            // cores the method keeps busy by itself (scheduling, runner.h)

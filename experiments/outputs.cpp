@@ -38,7 +38,10 @@ const std::vector<std::string>& result_columns() {
   static const std::vector<std::string> c = [] {
     std::vector<std::string> v = required_columns();
     for (const char* e : {"label", "sampling", "sweep", "seed", "status", "errors_after_term", "negative_texels",
-                          "order", "view_order", "tolerance", "tolerance_reached", "shade_rmse", "notes"})
+                          "order", "view_order", "tolerance", "tolerance_reached", "shade_rmse",
+                          "refine", "refine_seconds", "rel_mse_before", "rel_mae_before", "rel_max_before",
+                          "lin_rmse_before", "lin_mae_before", "lin_max_before", "cos_rmse_before", "model",
+                          "notes"})
       v.push_back(e);
     return v;
   }();
@@ -48,8 +51,9 @@ const std::vector<std::string>& result_columns() {
 std::vector<std::string> display_columns(const std::vector<RunEntry>& runs) {
   std::vector<std::string> cols = required_columns();
   cols.insert(cols.begin() + 3, "label");
-  for (const char* extra : {"order", "view_order", "tolerance", "tolerance_reached", "shade_rmse", "seed",
-                            "sampling", "sweep", "notes"})
+  for (const char* extra : {"order", "view_order", "tolerance", "tolerance_reached", "shade_rmse", "refine",
+                            "refine_seconds", "rel_mse_before", "lin_rmse_before", "cos_rmse_before", "seed",
+                            "sampling", "sweep", "model", "notes"})
     for (const auto& r : runs) {
       auto it = r.row.find(extra);
       if (it != r.row.end() && !it->second.empty()) {

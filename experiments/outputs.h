@@ -21,7 +21,8 @@ inline constexpr const char* kBrdfFactorVersion = "0.1.0";
 const std::vector<std::string>& required_columns();
 // ...then the extras: label, sampling, sweep, seed, status, errors_after_term,
 // negative_texels, order, view_order, tolerance, tolerance_reached,
-// shade_rmse, notes (docs/experiments.md says what each holds).
+// shade_rmse, refine, refine_seconds, <metric>_before (the 7 metrics of the
+// fit before refinement), model, notes (docs/experiments.md says what each holds).
 const std::vector<std::string>& result_columns();
 
 // One results row: column -> cell text; a missing column is an empty cell.
@@ -30,8 +31,9 @@ using Row = std::map<std::string, std::string>;
 struct RunEntry;
 // Columns of the tables for people (results.md, report.html): the required
 // ones with `label` after `method`, then those extras that some row fills
-// (order, view_order, tolerance, tolerance_reached, shade_rmse, seed,
-// sampling, sweep, notes).
+// (order, view_order, tolerance, tolerance_reached, shade_rmse, refine,
+// refine_seconds, rel_mse_before, lin_rmse_before, cos_rmse_before, seed,
+// sampling, sweep, model, notes).
 std::vector<std::string> display_columns(const std::vector<RunEntry>& runs);
 
 // Numbers as cells: %.9g; "" for NaN or infinity (never written as text).

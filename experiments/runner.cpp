@@ -23,6 +23,8 @@
 #include "experiments/render.h"
 #include "factor/export.h"
 #include "factor/metrics.h"
+#include "factor/model_fit.h"
+#include "factor/refine.h"
 #if __has_include("brdfs/measured.h")
 #include "brdfs/measured.h"
 #define BF_HAVE_MEASURED 1
@@ -155,6 +157,7 @@ std::string describe_method(const MethodVariant& m) {
       {"svd", {"terms", "texture_size", "parameterization", "log"}},
       {"sh-k", {"order", "texture_size"}},
       {"sh-r", {"order", "view_order"}},
+      {"model-fit", {"model", "metric", "anisotropic", "lobes", "starts", "seed"}},
   };
   std::string s = m.label;
   if (m.label != m.kind) s += " (" + m.kind + ")";
@@ -166,6 +169,7 @@ std::string describe_method(const MethodVariant& m) {
       s += " " + k + "=" + (v.is_string() ? v.get<std::string>() : v.dump());
     }
   if (m.tolerance) s += " tolerance=" + m.tolerance->metric + "<=" + format_number(m.tolerance->value);
+  if (m.refine != "none") s += " refine=" + m.refine;
   return s;
 }
 
@@ -241,7 +245,7 @@ RunEntry execute_run(const Plan& plan, const PlannedRun& pr, const SampleSet& sa
   set_presentation(row, plan, pr);
   json seeds = {{"experiment", plan.experiment.seed}};
   if (s.kind == "stratified") seeds["sampling"] = s.seed;
-  if (m.kind == "search") seeds["method"] = m.seed;
+  if (m.kind == "search" || m.kind == "model-fit") seeds["method"] = m.seed;
   json rec = {{"run_id", pr.run_id},
               {"identity", pr.identity},
               {"brdf", {{"label", b.label}, {"eval", b.brdf->to_string()}}},
@@ -319,6 +323,40 @@ RunEntry execute_run(const Plan& plan, const PlannedRun& pr, const SampleSet& sa
   } else if (m.kind == "sh-r") {
     if (m.tolerance) choice = select_shr_orders_by_metric(*b.brdf, samples, m.shr, *m.tolerance);
     else f = fit_shr(*b.brdf, m.shr);
+  } else if (m.kind == "model-fit") {
+    auto mf = std::make_shared<ModelFitFactorization>(fit_model(samples, m.model_fit));
+    const ModelFitResult& res = mf->result();
+    json params = json::object();
+    for (const auto& [k, v] : res.parameters) params[k] = v;
+    rec["model_fit"] = {{"spec", res.spec}, {"parameters", params}, {"cost", res.cost},
+                        {"best_start", res.best_start}, {"start_costs", res.start_costs},
+                        {"iterations", res.iterations}};
+    evaluations = res.iterations;
+    f = mf;
+  }
+  // Refinement (factor/refine.h) of a homomorphic fit: the row reports the
+  // refined factorization, the *_before columns the fit it started from.
+  Metrics before;
+  double refine_seconds = 0;
+  if (h && m.refine != "none") {
+    before = evaluate_metrics(*h, samples, lt);
+    const auto tr = Clock::now();
+    RefineReport rep;
+    try {
+      h = refine(*h, samples, m.refine_options, &rep);
+      rec["refinement"] = {{"objective", rep.objective},        {"linear_solver", rep.linear_solver},
+                           {"iterations", rep.iterations},      {"seconds", rep.seconds},
+                           {"initial_cost", rep.initial_cost},  {"final_cost", rep.final_cost},
+                           {"termination", rep.termination},    {"parameters", rep.parameters},
+                           {"residuals", rep.residuals},        {"texels_added", rep.texels_added},
+                           {"blend_weight", m.refine_options.blend_weight},
+                           {"smoothing", m.refine_options.smoothing}};
+    } catch (const std::runtime_error& ex) {
+      // Ceres found no finite solution: the start is the best answer.
+      notes.push_back(std::string("refinement failed, unrefined fit kept: ") + ex.what());
+      rec["refinement"] = {{"failed", ex.what()}};
+    }
+    refine_seconds = since(tr);
   }
   const double seconds = since(t0);
   if (h) f = h;
@@ -351,6 +389,16 @@ RunEntry execute_run(const Plan& plan, const PlannedRun& pr, const SampleSet& sa
     for (double v : errs) ec.push_back(format_number(v));
     row["errors_after_term"] = join(ec, ";");
     rec["reconstruction"] = h->subtract_eps() ? "A exp(s) - eps A, clamped at 0" : "A exp(s)";
+    if (m.refine != "none") {
+      row["refine"] = m.refine;
+      row["refine_seconds"] = format_number(std::round(refine_seconds * 1000.0) / 1000.0);
+      const std::pair<const char*, double> cells[] = {
+          {"rel_mse_before", before.rel_mse},   {"rel_mae_before", before.rel_mae},
+          {"rel_max_before", before.rel_max},   {"lin_rmse_before", before.lin_rmse},
+          {"lin_mae_before", before.lin_mae},   {"lin_max_before", before.lin_max},
+          {"cos_rmse_before", before.cos_rmse}};
+      for (const auto& [k, v] : cells) row[k] = format_number(v);
+    }
   } else if (auto svd = std::dynamic_pointer_cast<const SvdFactorization>(f)) {
     row["parameterization"] = to_string(svd->options().param);
     row["terms"] = std::to_string(svd->rank());
@@ -369,6 +417,8 @@ RunEntry execute_run(const Plan& plan, const PlannedRun& pr, const SampleSet& sa
   } else if (auto shr = std::dynamic_pointer_cast<const ShrFactorization>(f)) {
     row["order"] = std::to_string(shr->order());
     row["view_order"] = std::to_string(shr->view_order());
+  } else if (auto mf = std::dynamic_pointer_cast<const ModelFitFactorization>(f)) {
+    row["model"] = mf->result().spec;
   }
   row["samples"] = std::to_string(mt.samples);
   const std::pair<const char*, double> metric_cells[] = {
@@ -381,7 +431,7 @@ RunEntry execute_run(const Plan& plan, const PlannedRun& pr, const SampleSet& sa
   row["storage_floats"] = std::to_string(f->storage_floats());
   row["seconds"] = format_number(std::round(seconds * 1000.0) / 1000.0);
   row["evaluations"] = std::to_string(evaluations);
-  row["seed"] = m.kind == "search" ? std::to_string(m.seed) : "";
+  row["seed"] = m.kind == "search" || m.kind == "model-fit" ? std::to_string(m.seed) : "";
   row["status"] = "ok";
   if (choice) {
     row["tolerance"] = choice->metric + "<=" + format_number(m.tolerance->value);
@@ -400,6 +450,8 @@ RunEntry execute_run(const Plan& plan, const PlannedRun& pr, const SampleSet& sa
   // Files.
   if (plan.experiment.export_factors) {
     if (h) write_factorization(*h, run_dir.string(), "factors");
+    else if (auto mf = std::dynamic_pointer_cast<const ModelFitFactorization>(f))
+      write_model_fit(mf->result(), (run_dir / "model.json").string());
     else {
       const json d = f->describe();
       write_file_atomic((run_dir / "factorization.json").string(), [&](std::ostream& o) { o << d.dump(2) << "\n"; });

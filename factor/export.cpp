@@ -17,6 +17,7 @@
 
 #include "brdfs/catalogue.h"
 #include "factor/glsl.h"
+#include "factor/model_fit.h"
 
 namespace bf {
 
@@ -494,9 +495,20 @@ std::shared_ptr<HomomorphicFactorization> load_factorization(const std::string& 
   return std::make_shared<HomomorphicFactorization>(std::move(terms), A, eps, subtract_eps, method);
 }
 
+namespace {
+bool is_model_fit_file(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) return false;
+  const nlohmann::json j = nlohmann::json::parse(in, nullptr, false);
+  return j.is_object() && j.contains("format") && j["format"] == kModelFitFormat;
+}
+}  // namespace
+
 void register_export_loader(Catalogue& cat) {
   cat.add_loader(".json", [](const std::string& path, const ParamDict& options) -> BrdfPtr {
     options.check_unused("factorization sidecar", {});
+    // A model fit's file (factor/model_fit.h) is a catalogue spec in JSON.
+    if (is_model_fit_file(path)) return load_model_fit(path);
     return load_factorization(path);
   });
 }

@@ -8,7 +8,9 @@
 //   blinn-phong        kd (RGB), ks (RGB), n            fixed: normalization
 //   cook-torrance      kd, ks (RGB), m, f0 (Schlick)    fixed: form (fresnel must be schlick)
 //   ward               kd, ks (RGB), a = ax = ay        fixed: variant
+//                      (anisotropic: ax, ay)
 //   ashikhmin-shirley  rd, ks (RGB), rs, n = nu = nv    fixed: diffuse
+//                      (anisotropic: nu, nv)
 //   lafortune          rho_d (RGB); per lobe k < lobes: ks<k> (RGB), the lobe
 //                      direction angle alpha (cxy<k> = cos alpha / m,
 //                      cz<k> = sin alpha / m, m = max(|cos|, |sin|): the C
@@ -67,6 +69,10 @@ struct ModelFitOptions {
   // refused.
   std::string model = "cook-torrance";
   int lobes = 1;                  // lafortune only: 1..3
+  // ward, ashikhmin-shirley only: fit the two roughnesses (ax, ay) or
+  // exponents (nu, nv) separately, along the tangent frame's x and y axes
+  // (the catalogue models' frame); false fits one shared value.
+  bool anisotropic = false;
   std::string metric = "cosine";  // "cosine" | "log" (see above)
   bool cube_root = false;         // "cosine" only: compare cube roots (see above)
   double eps = 1e-5;              // "log": transform epsilon, 0 < eps <= 1
@@ -91,6 +97,7 @@ struct ModelFitResult {
   std::vector<std::pair<std::string, double>> parameters;
   std::string metric;       // as fitted
   bool cube_root = false;
+  bool anisotropic = false;  // as fitted
   double cost = 0;          // Ceres cost of the best start (half the sum of squared residuals)
   size_t storage_floats = 0;  // number of fitted parameters
   // Index of the winning start; -1 when the channels of a channel-separable
@@ -104,6 +111,23 @@ struct ModelFitResult {
   // Value of a fitted parameter by name; throws std::out_of_range naming it.
   double parameter(const std::string& name) const;
 };
+
+// Checks opt (validate()) and its model spec (known model, fixed options, lobes
+// and anisotropic allowed for it) without fitting: the experiment config calls
+// it so that a bad model is reported before any run. Throws
+// std::invalid_argument as fit_model() does. Returns the number of fitted
+// parameters (the storage of the fit).
+size_t check_model_fit(const ModelFitOptions& opt);
+
+// Reads back a model fit written by write_model_fit: the catalogue BRDF of its
+// `spec`. Throws std::invalid_argument naming the file and field.
+BrdfPtr load_model_fit(const std::string& json_path);
+// Model-fit files are JSON with "format" = this value (format_version 1):
+// describe() of the fit plus format and format_version; `spec` is what
+// load_model_fit (and `--brdf FILE.json`) rebuild.
+inline constexpr const char* kModelFitFormat = "brdf-factor-model-fit";
+// Writes the fit as such a file (atomically: a temporary renamed into place).
+void write_model_fit(const ModelFitResult& r, const std::string& path);
 
 // Fits opt.model to the valid samples of s. Throws std::invalid_argument for
 // invalid options, an unknown model or fixed option, fresnel=dielectric, or a

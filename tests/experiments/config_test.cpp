@@ -146,9 +146,9 @@ TEST_CASE("config: each rule broken gives one message with file:line, field and 
                     "[[method]]\nkind = \"fit\"\nprojections = [{ matrix = [[1, 1, 0, 0], [0, 0, 1, 0]] }]\n",
                 {"cfg.toml:12: method[0].projections[0].matrix:", "orthonormal"});
   }
-  SECTION("refine other than none is not implemented yet") {
-    require_one(std::string(kBase) + "[[method]]\nkind = \"mccool\"\nrefine = \"linear\"\n",
-                {"cfg.toml:12: method[0].refine:", "not implemented yet"});
+  SECTION("refine on a kind that is not homomorphic") {
+    require_one(std::string(kBase) + "[[method]]\nkind = \"svd\"\nrefine = \"linear\"\n",
+                {"cfg.toml:12: method[0].refine:", "homomorphic kinds"});
   }
   SECTION("tolerance where the method does not support it") {
     require_one(std::string(kBase) + "[[method]]\nkind = \"search\"\ntolerance = { metric = \"rel_mse\", value = 0.1 }\n",
