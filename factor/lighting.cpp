@@ -345,6 +345,12 @@ Shrm::Shrm(const ShrFactorization& shr, const ShLighting& lighting)
                 lambda(l) * shr.coefficient(c, l, p, std::abs(q)) * lighting.coeffs[c][sh_index(l, m)];
   }
   seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  Bs_.resize(sh_count(F_), 3 * npq_);
+  for (int c = 0; c < 3; ++c)
+    for (int l = 0; l <= F_; ++l)
+      for (int m = -l; m <= l; ++m)
+        for (int pq = 0; pq < npq_; ++pq)
+          Bs_(sh_index(l, m), c * npq_ + pq) = B_[c][size_t(sh_index(l, m)) * npq_ + pq] / lambda(l);
 }
 
 size_t Shrm::coefficient_count() const {
@@ -363,20 +369,17 @@ double Shrm::coefficient(int c, int l, int m, int p, int q) const {
 Rgb Shrm::eval_angles(double alpha, double beta, double theta_o, double phi_o) const {
   const Vec3 V(std::sin(theta_o) * std::cos(phi_o), std::sin(theta_o) * std::sin(phi_o), std::cos(theta_o));
   const Eigen::VectorXd ypq = sh_eval(P_, V);
+  // Every (channel, p, q) column rotated at once by D(M^T), M = Rz(beta) Ry(alpha):
+  // M^T = Ry(-alpha) Rz(-beta); then B_pq = sum_l (D(M^T) column)_{l, q}.
+  Eigen::MatrixXd C = Bs_;
+  rot_.rotate_zyz(0.0, -alpha, -beta, C);
   Rgb out = Rgb::Zero();
-  Eigen::VectorXd col(sh_count(F_));
   for (int c = 0; c < 3; ++c)
     for (int p = 0; p <= P_; ++p)
       for (int q = -p; q <= p; ++q) {
-        if (std::abs(q) > F_) continue;
         const int pq = pq_index(p, q);
-        for (int l = 0; l <= F_; ++l)
-          for (int m = -l; m <= l; ++m)
-            col[sh_index(l, m)] = B_[c][size_t(sh_index(l, m)) * npq_ + pq] / lambda(l);
-        // D(M^T) with M = Rz(beta) Ry(alpha): M^T = Ry(-alpha) Rz(-beta).
-        rot_.rotate_zyz(0.0, -alpha, -beta, col.data());
         double Bpq = 0.0;
-        for (int l = std::abs(q); l <= F_; ++l) Bpq += col[sh_index(l, q)];
+        for (int l = std::abs(q); l <= F_; ++l) Bpq += C(sh_index(l, q), c * npq_ + pq);
         out[c] += Bpq * ypq[pq];
       }
   return out;

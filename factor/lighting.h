@@ -156,6 +156,8 @@ class Shrm {
   int F_ = 0, P_ = 0;
   // B_[c][(l^2 + l + m) * Npq + pq], pq = p^2 + p + q (|q| <= p; 0 where |q| > l).
   std::array<std::vector<double>, 3> B_;
+  // Evaluation matrix: row sh_index(l, m), column c * Npq + pq, B_lmpq / Lambda_l.
+  Eigen::MatrixXd Bs_;
   int npq_ = 0;
   ShFastRotator rot_;
   double seconds_ = 0;

@@ -75,15 +75,57 @@ Eigen::VectorXd sh_rotate(const Eigen::Matrix3d& R, const Eigen::VectorXd& c) {
 }
 
 void sh_rotate_z(int order, double angle, double* c) {
-  for (int l = 1; l <= order; ++l)
-    for (int m = 1; m <= l; ++m) {
-      const double cm = std::cos(m * angle), sm = std::sin(m * angle);
+  // cos(m a), sin(m a) by the angle-addition recurrence (two trig calls per
+  // rotation; the error grows ~ m * 1e-16, negligible for m <= 200).
+  const double c1 = std::cos(angle), s1 = std::sin(angle);
+  double cm = 1.0, sm = 0.0;
+  for (int m = 1; m <= order; ++m) {
+    const double cn = cm * c1 - sm * s1;
+    sm = sm * c1 + cm * s1;
+    cm = cn;
+    for (int l = m; l <= order; ++l) {
       double& p = c[sh_index(l, m)];
       double& n = c[sh_index(l, -m)];
       const double a = p, b = n;
       p = a * cm - b * sm;
       n = a * sm + b * cm;
     }
+  }
+}
+
+void sh_rotate_z(int order, double angle, Eigen::MatrixXd& C) {
+  const double c1 = std::cos(angle), s1 = std::sin(angle);
+  double cm = 1.0, sm = 0.0;
+  Eigen::RowVectorXd a, b;
+  for (int m = 1; m <= order; ++m) {
+    const double cn = cm * c1 - sm * s1;
+    sm = sm * c1 + cm * s1;
+    cm = cn;
+    for (int l = m; l <= order; ++l) {
+      a = C.row(sh_index(l, m));
+      b = C.row(sh_index(l, -m));
+      C.row(sh_index(l, m)) = a * cm - b * sm;
+      C.row(sh_index(l, -m)) = a * sm + b * cm;
+    }
+  }
+}
+
+void ShFastRotator::rotate_zyz(double a, double b, double g, Eigen::MatrixXd& C) const {
+  if (C.rows() != sh_count(order_))
+    throw std::invalid_argument("sh fast rotator: expected " + std::to_string(sh_count(order_)) + " rows, found " +
+                                std::to_string(C.rows()));
+  Eigen::MatrixXd tmp;
+  sh_rotate_z(order_, g, C);
+  for (int l = 1; l <= order_; ++l) {
+    tmp = xp_[l] * C.middleRows(l * l, 2 * l + 1);
+    C.middleRows(l * l, 2 * l + 1) = tmp;
+  }
+  sh_rotate_z(order_, b, C);
+  for (int l = 1; l <= order_; ++l) {
+    tmp = xm_[l] * C.middleRows(l * l, 2 * l + 1);
+    C.middleRows(l * l, 2 * l + 1) = tmp;
+  }
+  sh_rotate_z(order_, a, C);
 }
 
 ShFastRotator::ShFastRotator(int order) : order_(order) {

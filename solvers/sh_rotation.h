@@ -44,6 +44,8 @@ Eigen::VectorXd sh_rotate(const Eigen::Matrix3d& R, const Eigen::VectorXd& c);
 //   c'_m = c_m cos(m a) - c_{-m} sin(m a),  c'_{-m} = c_m sin(m a) + c_{-m} cos(m a).
 // O((F+1)^2); c holds sh_count(order) values.
 void sh_rotate_z(int order, double angle, double* c);
+// Same for every column of C ((F+1)^2 rows).
+void sh_rotate_z(int order, double angle, Eigen::MatrixXd& C);
 
 // Fast rotation of real SH coefficients by zyz Euler angles (Kautz et al.
 // 2002 Appendix, method 2): D(R_y(b)) = D(R_x(-90)) D(R_z(b)) D(R_x(+90)),
@@ -55,6 +57,8 @@ class ShFastRotator {
   int order() const { return order_; }
   // c <- D(R) c for R = R_z(a) R_y(b) R_z(g) (c: sh_count(order) values).
   void rotate_zyz(double a, double b, double g, double* c) const;
+  // Every column of C ((F+1)^2 rows) rotated at once (block products).
+  void rotate_zyz(double a, double b, double g, Eigen::MatrixXd& C) const;
   // c <- D(R) c for any rotation R (to 1e-9; Euler angles extracted, both
   // gimbal cases handled). Throws std::invalid_argument for a non-rotation.
   void rotate(const Eigen::Matrix3d& R, double* c) const;
