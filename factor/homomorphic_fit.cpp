@@ -122,60 +122,227 @@ void laplacian_rows(const TermLayout& t, AddFn add_row) {
     }
 }
 
+
+// A term's lookups: per sample, the lower-left texel of its bilinear cell and
+// the fractions (projection, and conjugate if reciprocal).
+struct Lookups {
+  std::vector<int> cell;           // per sample: j * res + i
+  std::vector<double> fa, fb;      // per sample: fractions in [0, 1]
+};
+
+// Appends one joint term: mask (thesis 3.2.4) extended by every texel a sample
+// touches, so no sample ever reads a texel that is not an unknown; unknowns
+// numbered from M on.
+void add_layout(const FitData& d, const TermSpec& s, int& M, std::vector<TermLayout>& terms,
+                std::array<Lookups, 2>& lk) {
+  const size_t N = d.size();
+  s.proj.validate();
+  TermLayout t{FastProj(s.proj), FastProj(s.proj.conjugate()), s.reciprocal,
+               &d.points(s.proj.param), {}, projection_mask(s.proj), 0, 0};
+  const std::vector<Vec4>& x = *t.x;
+  const int R = s.proj.res;
+  for (int h = 0; h < (t.reciprocal ? 2 : 1); ++h) {
+    const FastProj& fp = h == 0 ? t.proj : t.conj;
+    Lookups& L = lk[h];
+    L.cell.resize(N);
+    L.fa.resize(N);
+    L.fb.resize(N);
+    for (size_t k = 0; k < N; ++k) {
+      const double u = std::clamp(fp.M.row(0).dot(x[k]) + fp.off, 0.0, double(R - 1));
+      const double v = std::clamp(fp.M.row(1).dot(x[k]) + fp.off, 0.0, double(R - 1));
+      const int i = std::min(static_cast<int>(u), R - 2), j = std::min(static_cast<int>(v), R - 2);
+      const int c = j * R + i;
+      L.cell[k] = c;
+      L.fa[k] = u - i;
+      L.fb[k] = v - j;
+      t.mask[c] = t.mask[c + 1] = t.mask[c + R] = t.mask[c + R + 1] = 1;
+    }
+  }
+  t.unk.assign(t.mask.size(), -1);
+  t.first = M;
+  for (size_t i = 0; i < t.mask.size(); ++i)
+    if (t.mask[i]) t.unk[i] = M++;
+  t.count = M - t.first;
+  terms.push_back(std::move(t));
+}
+
+// The data part of the dense normal equations (lower triangle of A, rhs and
+// sum w r^2 per channel) for terms first_new.. and their products with the
+// earlier terms; blocks among terms before first_new are left as they are (a
+// JointPrefix filled them). Fast assembly: a lookup's 4x4 self-product only
+// touches the texels of its bilinear cell, so it is accumulated (10 sums, plus
+// 4x3 right-hand side sums) per (term, cell) in small arrays that stay in
+// cache and scattered once; products of two different lookups (different
+// terms, or a reciprocal term's projection and conjugate) go straight into the
+// lower triangle of A (column-major, 4 columns x 4 rows each).
+void assemble_dense(const FitData& d, const std::array<std::vector<double>, 3>& fixed_values,
+                    const std::vector<TermLayout>& terms,
+                    const std::vector<const std::array<Lookups, 2>*>& lookups, size_t first_new,
+                    Eigen::MatrixXd& A, Eigen::MatrixXd& rhs, double sum_wr2[3]) {
+  const size_t N = d.size();
+  double* Ad = A.data();
+  const size_t MM = static_cast<size_t>(A.rows());
+  struct CellAcc {
+    double q[10];  // (0,0) (1,0) (2,0) (3,0) (1,1) (2,1) (3,1) (2,2) (3,2) (3,3)
+    double r[4][3];
+  };
+  std::vector<std::vector<CellAcc>> cells(terms.size());
+  for (size_t ti = first_new; ti < terms.size(); ++ti)
+    cells[ti].assign(size_t(terms[ti].proj.res) * terms[ti].proj.res, CellAcc{});
+  // Flattened lookup list: (term, half) pairs in order.
+  std::vector<std::pair<int, int>> subs;
+  int first_new_sub = -1;
+  for (size_t ti = 0; ti < terms.size(); ++ti)
+    for (int h = 0; h < (terms[ti].reciprocal ? 2 : 1); ++h) {
+      if (ti >= first_new && first_new_sub < 0) first_new_sub = static_cast<int>(subs.size());
+      subs.emplace_back(int(ti), h);
+    }
+  const int S = static_cast<int>(subs.size());
+  if (first_new_sub < 0) first_new_sub = S;
+  std::vector<int> sidx(4 * S);
+  std::vector<double> sw(4 * S);
+  for (int c = 0; c < 3; ++c) sum_wr2[c] = 0;
+  for (size_t k = 0; k < N; ++k) {
+    const double w = d.w[k];
+    const double r[3] = {d.g[0][k] - fixed_values[0][k], d.g[1][k] - fixed_values[1][k],
+                         d.g[2][k] - fixed_values[2][k]};
+    for (int c = 0; c < 3; ++c) sum_wr2[c] += w * r[c] * r[c];
+    for (int p = 0; p < S; ++p) {
+      const int ti = subs[p].first;
+      const Lookups& lk = (*lookups[ti])[subs[p].second];
+      const int cell = lk.cell[k];
+      const double fa = lk.fa[k], fb = lk.fb[k];
+      const double b0 = (1 - fa) * (1 - fb), b1 = fa * (1 - fb), b2 = (1 - fa) * fb, b3 = fa * fb;
+      if (p >= first_new_sub) {
+        CellAcc& acc = cells[ti][cell];
+        const double wb0 = w * b0, wb1 = w * b1, wb2 = w * b2, wb3 = w * b3;
+        acc.q[0] += wb0 * b0; acc.q[1] += wb1 * b0; acc.q[2] += wb2 * b0; acc.q[3] += wb3 * b0;
+        acc.q[4] += wb1 * b1; acc.q[5] += wb2 * b1; acc.q[6] += wb3 * b1;
+        acc.q[7] += wb2 * b2; acc.q[8] += wb3 * b2; acc.q[9] += wb3 * b3;
+        for (int c = 0; c < 3; ++c) {
+          acc.r[0][c] += wb0 * r[c]; acc.r[1][c] += wb1 * r[c];
+          acc.r[2][c] += wb2 * r[c]; acc.r[3][c] += wb3 * r[c];
+        }
+      }
+      if (S > 1) {
+        const int R = terms[ti].proj.res;
+        const std::vector<int>& unk = terms[ti].unk;
+        sidx[4 * p] = unk[cell]; sidx[4 * p + 1] = unk[cell + 1];
+        sidx[4 * p + 2] = unk[cell + R]; sidx[4 * p + 3] = unk[cell + R + 1];
+        sw[4 * p] = b0; sw[4 * p + 1] = b1; sw[4 * p + 2] = b2; sw[4 * p + 3] = b3;
+      }
+    }
+    // Cross products of different lookups: q later than p, so for different
+    // terms idx_q > idx_p (lower triangle). Same-term pairs are folded below.
+    // Pairs with both lookups before first_new are the prefix's.
+    for (int p = 0; p < S; ++p)
+      for (int q = std::max(p + 1, first_new_sub); q < S; ++q)
+        for (int a2 = 0; a2 < 4; ++a2) {
+          double* col = Ad + static_cast<size_t>(sidx[4 * p + a2]) * MM;
+          const double wa = w * sw[4 * p + a2];
+          col[sidx[4 * q]] += wa * sw[4 * q];
+          col[sidx[4 * q + 1]] += wa * sw[4 * q + 1];
+          col[sidx[4 * q + 2]] += wa * sw[4 * q + 2];
+          col[sidx[4 * q + 3]] += wa * sw[4 * q + 3];
+        }
+  }
+  // Fold reciprocal terms' upper-triangle entries into the lower triangle.
+  // Each cross product s_p s_q^T was added once; the symmetric pair
+  // s_p s_q^T + s_q s_p^T needs its diagonal twice. (So far only these
+  // same-term cross products have touched the term's diagonal block.)
+  for (size_t ti = first_new; ti < terms.size(); ++ti) {
+    const TermLayout& t = terms[ti];
+    if (!t.reciprocal) continue;
+    for (int j = t.first; j < t.first + t.count; ++j) {
+      A(j, j) *= 2.0;
+      for (int i = t.first; i < j; ++i) {
+        A(j, i) += A(i, j);
+        A(i, j) = 0.0;
+      }
+    }
+  }
+  // Scatter the per-cell sums into the lower triangle and the right-hand side.
+  for (size_t ti = first_new; ti < terms.size(); ++ti) {
+    const TermLayout& t = terms[ti];
+    const int R = t.proj.res;
+    for (size_t cell = 0; cell < cells[ti].size(); ++cell) {
+      const CellAcc& acc = cells[ti][cell];
+      if (acc.q[0] == 0 && acc.q[4] == 0 && acc.q[7] == 0 && acc.q[9] == 0) continue;
+      const int id[4] = {t.unk[cell], t.unk[cell + 1], t.unk[cell + R], t.unk[cell + R + 1]};
+      const int pairs[10][2] = {{0, 0}, {1, 0}, {2, 0}, {3, 0}, {1, 1},
+                                {2, 1}, {3, 1}, {2, 2}, {3, 2}, {3, 3}};
+      for (int e = 0; e < 10; ++e) {
+        const int i = id[pairs[e][0]], j = id[pairs[e][1]];
+        A(std::max(i, j), std::min(i, j)) += acc.q[e];
+      }
+      for (int v = 0; v < 4; ++v)
+        for (int c = 0; c < 3; ++c) rhs(id[v], c) += acc.r[v][c];
+    }
+  }
+}
+
 }  // namespace
+
+struct JointPrefix::Impl {
+  std::vector<TermSpec> known;
+  std::vector<TermLayout> terms;
+  std::vector<std::array<Lookups, 2>> lookups;
+  int M = 0;
+  Eigen::MatrixXd A, rhs;  // data block of the known terms (lower triangle), M x M and M x 3
+};
+
+JointPrefix::JointPrefix(const FitData& d, const std::array<std::vector<double>, 3>& fixed_values,
+                         const std::vector<TermSpec>& known, const FitOptions& opt)
+    : impl_(std::make_unique<Impl>()) {
+  opt.validate();
+  Impl& p = *impl_;
+  p.known = known;
+  p.lookups.resize(known.size());
+  for (size_t i = 0; i < known.size(); ++i) add_layout(d, known[i], p.M, p.terms, p.lookups[i]);
+  p.A = Eigen::MatrixXd::Zero(p.M, p.M);
+  p.rhs = Eigen::MatrixXd::Zero(p.M, 3);
+  std::vector<const std::array<Lookups, 2>*> lp;
+  for (const auto& l : p.lookups) lp.push_back(&l);
+  double sum_wr2[3];
+  assemble_dense(d, fixed_values, p.terms, lp, 0, p.A, p.rhs, sum_wr2);
+}
+
+JointPrefix::~JointPrefix() = default;
+size_t JointPrefix::terms() const { return impl_->known.size(); }
 
 JointSolution solve_joint(const FitData& d, const std::array<std::vector<double>, 3>& fixed_values,
                           const std::vector<TermSpec>& joint, const FitOptions& opt,
-                          bool exact_error) {
+                          bool exact_error, const JointPrefix* prefix) {
   opt.validate();
   if (joint.empty()) throw std::invalid_argument("fit: no terms to solve");
   const size_t N = d.size();
 
-  // Layout: masks (thesis 3.2.4) extended by every texel a sample touches, so
-  // no sample ever reads a texel that is not an unknown. Each term has one or
-  // two "lookups" per sample (projection, and conjugate if reciprocal); a
-  // lookup is the lower-left texel of its bilinear cell and the fractions.
-  struct Lookups {
-    std::vector<int> cell;           // per sample: j * res + i
-    std::vector<double> fa, fb;      // per sample: fractions in [0, 1]
-  };
+  // Layout: the prefix's terms (if any), then the others.
+  size_t K = 0;  // terms taken from the prefix
   std::vector<TermLayout> terms;
-  std::vector<std::array<Lookups, 2>> lookups;
+  std::vector<std::array<Lookups, 2>> own(joint.size());
+  std::vector<const std::array<Lookups, 2>*> lookups;
   terms.reserve(joint.size());
   int M = 0;
-  for (const TermSpec& s : joint) {
-    s.proj.validate();
-    TermLayout t{FastProj(s.proj), FastProj(s.proj.conjugate()), s.reciprocal,
-                 &d.points(s.proj.param), {}, projection_mask(s.proj), 0, 0};
-    const std::vector<Vec4>& x = *t.x;
-    std::array<Lookups, 2> lk;
-    const int R = s.proj.res;
-    for (int h = 0; h < (t.reciprocal ? 2 : 1); ++h) {
-      const FastProj& fp = h == 0 ? t.proj : t.conj;
-      Lookups& L = lk[h];
-      L.cell.resize(N);
-      L.fa.resize(N);
-      L.fb.resize(N);
-      for (size_t k = 0; k < N; ++k) {
-        const double u = std::clamp(fp.M.row(0).dot(x[k]) + fp.off, 0.0, double(R - 1));
-        const double v = std::clamp(fp.M.row(1).dot(x[k]) + fp.off, 0.0, double(R - 1));
-        const int i = std::min(static_cast<int>(u), R - 2), j = std::min(static_cast<int>(v), R - 2);
-        const int c = j * R + i;
-        L.cell[k] = c;
-        L.fa[k] = u - i;
-        L.fb[k] = v - j;
-        t.mask[c] = t.mask[c + 1] = t.mask[c + R] = t.mask[c + R + 1] = 1;
-      }
-    }
-    t.unk.assign(t.mask.size(), -1);
-    t.first = M;
-    for (size_t i = 0; i < t.mask.size(); ++i)
-      if (t.mask[i]) t.unk[i] = M++;
-    t.count = M - t.first;
-    terms.push_back(std::move(t));
-    lookups.push_back(std::move(lk));
+  if (prefix) {
+    const JointPrefix::Impl& p = prefix->impl();
+    K = p.known.size();
+    if (K >= joint.size())
+      throw std::invalid_argument("fit: a prefix of " + std::to_string(K) + " terms for " +
+                                  std::to_string(joint.size()) + " joint terms (expected fewer)");
+    for (size_t i = 0; i < K; ++i)
+      if (joint[i].proj.P != p.known[i].proj.P || joint[i].proj.res != p.known[i].proj.res ||
+          joint[i].proj.param != p.known[i].proj.param || joint[i].reciprocal != p.known[i].reciprocal)
+        throw std::invalid_argument("fit: joint term " + std::to_string(i + 1) +
+                                    " differs from the prefix's term it should equal");
+    terms = p.terms;
+    for (size_t i = 0; i < K; ++i) lookups.push_back(&p.lookups[i]);
+    M = p.M;
   }
-
+  for (size_t i = K; i < joint.size(); ++i) {
+    add_layout(d, joint[i], M, terms, own[i]);
+    lookups.push_back(&own[i]);
+  }
   // Per-sample stencils: up to 8 entries per term.
   const int maxL = 8 * static_cast<int>(terms.size());
   auto stencil = [&](size_t k, int* idx, double* val) {
@@ -184,7 +351,7 @@ JointSolution solve_joint(const FitData& d, const std::array<std::vector<double>
       const TermLayout& t = terms[ti];
       const int R = t.proj.res;
       for (int h = 0; h < (t.reciprocal ? 2 : 1); ++h) {
-        const Lookups& lk = lookups[ti][h];
+        const Lookups& lk = (*lookups[ti])[h];
         const int c = lk.cell[k];
         const double a = lk.fa[k], b = lk.fb[k];
         idx[L] = t.unk[c];
@@ -256,104 +423,15 @@ JointSolution solve_joint(const FitData& d, const std::array<std::vector<double>
                                std::to_string(M) + " unknowns)");
     Y = llt.solve(rhs);
   } else if (solver == FitOptions::Solver::Dense) {
-    // Fast dense assembly. A lookup's 4x4 self-product only touches the texels
-    // of its bilinear cell: accumulate it (10 sums, plus 4x3 right-hand side
-    // sums) per (term, cell) in small arrays that stay in cache, and scatter
-    // them once. Products of two different lookups (different terms, or a
-    // reciprocal term's projection and conjugate) go straight into the lower
-    // triangle of A (column-major, 4 columns x 4 rows each).
     Eigen::MatrixXd A = Eigen::MatrixXd::Zero(M, M);
     Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(M, 3);
-    double* Ad = A.data();
-    const size_t MM = static_cast<size_t>(M);
-    struct CellAcc {
-      double q[10];  // (0,0) (1,0) (2,0) (3,0) (1,1) (2,1) (3,1) (2,2) (3,2) (3,3)
-      double r[4][3];
-    };
-    std::vector<std::vector<CellAcc>> cells(terms.size());
-    for (size_t ti = 0; ti < terms.size(); ++ti)
-      cells[ti].assign(size_t(terms[ti].proj.res) * terms[ti].proj.res, CellAcc{});
-    // Flattened lookup list: (term, half) pairs in order.
-    std::vector<std::pair<int, int>> subs;
-    for (size_t ti = 0; ti < terms.size(); ++ti)
-      for (int h = 0; h < (terms[ti].reciprocal ? 2 : 1); ++h) subs.emplace_back(int(ti), h);
-    const int S = static_cast<int>(subs.size());
-    std::vector<int> sidx(4 * S);
-    std::vector<double> sw(4 * S);
-    double sum_wr2[3] = {0, 0, 0};
-    for (size_t k = 0; k < N; ++k) {
-      const double w = d.w[k];
-      const double r[3] = {d.g[0][k] - fixed_values[0][k], d.g[1][k] - fixed_values[1][k],
-                           d.g[2][k] - fixed_values[2][k]};
-      for (int c = 0; c < 3; ++c) sum_wr2[c] += w * r[c] * r[c];
-      for (int p = 0; p < S; ++p) {
-        const int ti = subs[p].first;
-        const Lookups& lk = lookups[ti][subs[p].second];
-        const int cell = lk.cell[k];
-        const double fa = lk.fa[k], fb = lk.fb[k];
-        const double b0 = (1 - fa) * (1 - fb), b1 = fa * (1 - fb), b2 = (1 - fa) * fb, b3 = fa * fb;
-        CellAcc& acc = cells[ti][cell];
-        const double wb0 = w * b0, wb1 = w * b1, wb2 = w * b2, wb3 = w * b3;
-        acc.q[0] += wb0 * b0; acc.q[1] += wb1 * b0; acc.q[2] += wb2 * b0; acc.q[3] += wb3 * b0;
-        acc.q[4] += wb1 * b1; acc.q[5] += wb2 * b1; acc.q[6] += wb3 * b1;
-        acc.q[7] += wb2 * b2; acc.q[8] += wb3 * b2; acc.q[9] += wb3 * b3;
-        for (int c = 0; c < 3; ++c) {
-          acc.r[0][c] += wb0 * r[c]; acc.r[1][c] += wb1 * r[c];
-          acc.r[2][c] += wb2 * r[c]; acc.r[3][c] += wb3 * r[c];
-        }
-        if (S > 1) {
-          const int R = terms[ti].proj.res;
-          const std::vector<int>& unk = terms[ti].unk;
-          sidx[4 * p] = unk[cell]; sidx[4 * p + 1] = unk[cell + 1];
-          sidx[4 * p + 2] = unk[cell + R]; sidx[4 * p + 3] = unk[cell + R + 1];
-          sw[4 * p] = b0; sw[4 * p + 1] = b1; sw[4 * p + 2] = b2; sw[4 * p + 3] = b3;
-        }
-      }
-      // Cross products of different lookups: q later than p, so for different
-      // terms idx_q > idx_p (lower triangle). Same-term pairs are folded below.
-      for (int p = 0; p < S; ++p)
-        for (int q = p + 1; q < S; ++q)
-          for (int a2 = 0; a2 < 4; ++a2) {
-            double* col = Ad + static_cast<size_t>(sidx[4 * p + a2]) * MM;
-            const double wa = w * sw[4 * p + a2];
-            col[sidx[4 * q]] += wa * sw[4 * q];
-            col[sidx[4 * q + 1]] += wa * sw[4 * q + 1];
-            col[sidx[4 * q + 2]] += wa * sw[4 * q + 2];
-            col[sidx[4 * q + 3]] += wa * sw[4 * q + 3];
-          }
+    if (K > 0) {  // the prefix's data block
+      const JointPrefix::Impl& p = prefix->impl();
+      A.topLeftCorner(p.M, p.M) = p.A;
+      rhs.topRows(p.M) = p.rhs;
     }
-    // Fold reciprocal terms' upper-triangle entries into the lower triangle.
-    // Each cross product s_p s_q^T was added once; the symmetric pair
-    // s_p s_q^T + s_q s_p^T needs its diagonal twice. (So far only these
-    // same-term cross products have touched A's diagonal.)
-    for (const TermLayout& t : terms) {
-      if (!t.reciprocal) continue;
-      for (int j = t.first; j < t.first + t.count; ++j) {
-        A(j, j) *= 2.0;
-        for (int i = t.first; i < j; ++i) {
-          A(j, i) += A(i, j);
-          A(i, j) = 0.0;
-        }
-      }
-    }
-    // Scatter the per-cell sums into the lower triangle and the right-hand side.
-    for (size_t ti = 0; ti < terms.size(); ++ti) {
-      const TermLayout& t = terms[ti];
-      const int R = t.proj.res;
-      for (size_t cell = 0; cell < cells[ti].size(); ++cell) {
-        const CellAcc& acc = cells[ti][cell];
-        if (acc.q[0] == 0 && acc.q[4] == 0 && acc.q[7] == 0 && acc.q[9] == 0) continue;
-        const int id[4] = {t.unk[cell], t.unk[cell + 1], t.unk[cell + R], t.unk[cell + R + 1]};
-        const int pairs[10][2] = {{0, 0}, {1, 0}, {2, 0}, {3, 0}, {1, 1},
-                                  {2, 1}, {3, 1}, {2, 2}, {3, 2}, {3, 3}};
-        for (int e = 0; e < 10; ++e) {
-          const int i = id[pairs[e][0]], j = id[pairs[e][1]];
-          A(std::max(i, j), std::min(i, j)) += acc.q[e];
-        }
-        for (int v = 0; v < 4; ++v)
-          for (int c = 0; c < 3; ++c) rhs(id[v], c) += acc.r[v][c];
-      }
-    }
+    double sum_wr2[3];
+    assemble_dense(d, fixed_values, terms, lookups, K, A, rhs, sum_wr2);
     double reg_diag = 0;  // Laplacian, gauge and ridge go into A; remember them for the objective
     for (const TermLayout& t : terms)
       laplacian_rows(t, [&](const int* li, const double* lv, int n) {

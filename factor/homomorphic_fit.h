@@ -90,12 +90,36 @@ struct JointSolution {
 // Sum of the given (fixed) terms' log values at every sample, per channel.
 std::array<std::vector<double>, 3> fixed_sum(const FitData& d, const std::vector<FactorTerm>& fixed);
 
+// What solve_joint computes for the first joint terms alone: their texel
+// layout, per-sample bilinear lookups and their block of B^T W B and B^T W r
+// (before smoothing, gauge and ridge, which depend on the whole system). A
+// search that changes only the last joint term (TermObjective) builds it once
+// and passes it to every solve. Valid only with the same FitData and
+// fixed_values it was built from (the caller's contract; the specs are checked).
+class JointPrefix {
+ public:
+  JointPrefix(const FitData& d, const std::array<std::vector<double>, 3>& fixed_values,
+              const std::vector<TermSpec>& known, const FitOptions& opt);
+  ~JointPrefix();
+  JointPrefix(const JointPrefix&) = delete;
+  JointPrefix& operator=(const JointPrefix&) = delete;
+  size_t terms() const;
+  struct Impl;
+  const Impl& impl() const { return *impl_; }
+
+ private:
+  std::unique_ptr<Impl> impl_;
+};
+
 // Solves `joint` with `fixed_values` (from fixed_sum) held. Throws
 // std::invalid_argument for invalid projections, std::runtime_error if the
-// normal matrix is not positive definite.
+// normal matrix is not positive definite. With `prefix` (built from the same
+// data and fixed_values for joint's first prefix->terms() terms, else
+// std::invalid_argument), the dense path reuses its lookups and normal-matrix
+// block; the result equals the one without it up to summation order.
 JointSolution solve_joint(const FitData& d, const std::array<std::vector<double>, 3>& fixed_values,
                           const std::vector<TermSpec>& joint, const FitOptions& opt,
-                          bool exact_error = true);
+                          bool exact_error = true, const JointPrefix* prefix = nullptr);
 
 // rel_mse of a log-space model value s against target g (both per sample and
 // channel), with the reconstruction's clamping applied exactly as the metrics

@@ -57,7 +57,10 @@ void SearchOptions::validate() const {
 TermObjective::TermObjective(const FitData& data, const std::vector<FactorTerm>& fixed,
                              std::vector<TermSpec> joint_known, const SearchOptions& opt, int res)
     : data_(data), fixed_values_(fixed_sum(data, fixed)), joint_known_(std::move(joint_known)),
-      opt_(opt), res_(res) {}
+      opt_(opt), res_(res) {
+  if (!joint_known_.empty())
+    prefix_ = std::make_shared<JointPrefix>(data_, fixed_values_, joint_known_, opt_.fit);
+}
 
 TermSpec TermObjective::spec(const Rotation4& r) const {
   return TermSpec{r.projection(opt_.param, res_), opt_.reciprocity, r.packed()};
@@ -69,7 +72,7 @@ double TermObjective::operator()(const Rotation4& r) const {
   try {
     // The least-squares objective read off the normal equations (no pass over
     // the samples); the final refit reports the clamped metric.
-    return solve_joint(data_, fixed_values_, joint, opt_.fit, /*exact_error=*/false).rel_mse;
+    return solve_joint(data_, fixed_values_, joint, opt_.fit, /*exact_error=*/false, prefix_.get()).rel_mse;
   } catch (const std::runtime_error&) {
     return std::numeric_limits<double>::max();  // a failed solve is never chosen
   }

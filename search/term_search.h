@@ -89,6 +89,7 @@ class TermObjective {
   std::vector<TermSpec> joint_known_;
   const SearchOptions& opt_;
   int res_;
+  std::shared_ptr<const JointPrefix> prefix_;  // the held joint terms' part of every solve
 };
 
 // The objective of backfitting: the search-objective error of the whole fit

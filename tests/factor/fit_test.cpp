@@ -226,3 +226,45 @@ TEST_CASE("fit: the search objective read off the normal equations equals the sa
     CHECK(bf_test::near_rel(quick, exact, 1e-7));
   }
 }
+
+TEST_CASE("fit: a JointPrefix (held terms cached) gives the same solution as solving from scratch") {
+  const PlantedBrdf brdf;
+  const SampleSet s = sample_stratified(brdf, 3000, 29);
+  std::mt19937_64 rng(31);
+  FitOptions opt;
+  opt.solve_last = 3;
+  const FitData d(s, opt.eps);
+  // A fixed earlier term, so the residual targets are not the raw data.
+  const auto pre = fit_homomorphic(
+      d, {{bf_test::random_projection(rng, Parameterization::WiWo, 6), false, std::nullopt}}, opt);
+  const auto fixed_values = fixed_sum(d, pre->terms());
+  const std::vector<TermSpec> joint = {
+      {bf_test::random_projection(rng, Parameterization::WiWo, 8), true, std::nullopt},
+      {bf_test::random_projection(rng, Parameterization::HalfDiff, 8), false, std::nullopt},
+      {bf_test::random_projection(rng, Parameterization::WiWo, 8), true, std::nullopt}};
+  for (size_t known = 1; known <= 2; ++known) {
+    const JointPrefix prefix(d, fixed_values, std::vector<TermSpec>(joint.begin(), joint.begin() + known), opt);
+    REQUIRE(prefix.terms() == known);
+    for (bool exact : {false, true}) {
+      const JointSolution plain = solve_joint(d, fixed_values, joint, opt, exact);
+      const JointSolution cached = solve_joint(d, fixed_values, joint, opt, exact, &prefix);
+      INFO("known " << known << " exact " << exact);
+      CHECK(cached.unknowns == plain.unknowns);
+      CHECK(std::abs(cached.rel_mse - plain.rel_mse) <= 1e-10 * plain.rel_mse);
+      double worst = 0;
+      for (size_t t = 0; t < joint.size(); ++t)
+        for (int c = 0; c < 3; ++c)
+          for (size_t i = 0; i < plain.terms[t].texels[c].size(); ++i)
+            worst = std::max(worst, double(std::abs(cached.terms[t].texels[c][i] -
+                                                     plain.terms[t].texels[c][i])));
+      CHECK(worst <= 1e-6);  // texels are float
+    }
+  }
+  // A prefix whose terms are not the joint's first ones is refused.
+  const JointPrefix other(d, fixed_values, {joint[1]}, opt);
+  CHECK_THROWS_WITH(solve_joint(d, fixed_values, joint, opt, false, &other),
+                    Catch::Contains("joint term 1") && Catch::Contains("prefix"));
+  const JointPrefix all(d, fixed_values, joint, opt);
+  CHECK_THROWS_WITH(solve_joint(d, fixed_values, joint, opt, false, &all),
+                    Catch::Contains("prefix of 3 terms for 3 joint terms"));
+}
