@@ -66,8 +66,18 @@ std::string file_hash(const std::string& path) {
 std::string short_hash(const json& j) { return content_hash(j.dump()).substr(0, 12); }
 
 nlohmann::json SceneSettings::identity() const {
-  return {{"light", {light.x(), light.y(), light.z()}}, {"intensity", intensity}, {"size", size},
-          {"shade_rmse", named}};
+  nlohmann::json j = {{"light", {light.x(), light.y(), light.z()}}, {"intensity", intensity}, {"size", size},
+                      {"shade_rmse", named}};
+  // Only SH-lit scenes carry the lighting (point-lit run ids are unchanged).
+  if (lighting) {
+    j["lighting"] = {{"source", environment.empty() ? "directional" : "env"},
+                     {"digest", environment.empty() ? "" : file_hash(environment)},
+                     {"environment_eps", environment_eps},
+                     {"lighting_order", lighting_order},
+                     {"order", lighting->order},
+                     {"nodes", lighting_nodes}};
+  }
+  return j;
 }
 
 // ------------------------------------------------------------------ keys
@@ -92,7 +102,8 @@ const std::map<std::string, std::vector<std::string>>& key_table() {
       {"experiment", {"name", "seed", "out", "description", "jobs", "plots", "render", "export",
                       "metric_eps"}},
       {"sampling", {"kind", "resolution", "count", "seed", "path", "zip"}},
-      {"scene", {"light", "intensity", "size"}},
+      {"scene", {"light", "intensity", "size", "environment", "environment_eps", "lighting_order",
+                 "lighting_nodes"}},
       {"brdf", {"preset", "model", "file", "name", "zip"}},
       {"projection", {"parameterization", "matrix", "name", "reciprocal"}},
       {"tolerance", {"metric", "value"}},
@@ -112,11 +123,11 @@ const std::map<std::string, std::vector<std::string>>& key_table() {
                                  "float_textures", "tolerance"}})},
       {"method:sh-k", join_keys({kCommonMethodKeys,
                                  {"order", "texture_size", "theta_nodes", "phi_nodes", "rim_inset",
-                                  "min_cos", "float_textures", "tolerance"}})},
+                                  "min_cos", "float_textures", "tolerance", "reduce_isotropic"}})},
       {"method:sh-r", join_keys({kCommonMethodKeys,
                                  {"order", "view_order", "max_order", "max_view_order",
                                   "energy_eps", "theta_i_nodes", "theta_o_nodes", "phi_nodes",
-                                  "min_cos", "tolerance"}})},
+                                  "min_cos", "tolerance", "shrm"}})},
       {"method:model-fit", join_keys({kCommonMethodKeys,
                                       {"model", "metric", "cube_root", "anisotropic", "lobes", "eps",
                                        "starts", "seed", "max_iterations", "threads"}})},
@@ -791,8 +802,76 @@ SceneSettings read_scene(const toml::table* t, Ctx& ctx) {
   }
   s.intensity = r.number("intensity", s.intensity, 0.0, kInf, true);
   s.size = static_cast<int>(r.integer("size", s.size, 16, 1024));
+  // SH lighting (factor/lighting.h): an environment map with a measured band
+  // limit, or an explicit order (alone: the point light band-limited to it).
+  const bool has_env = r.has("environment"), has_order = r.has("lighting_order");
+  const std::string env = r.text("environment", "");
+  s.environment_eps = r.number("environment_eps", s.environment_eps, 0.0, 1.0, true);
+  s.lighting_order = static_cast<int>(r.integer("lighting_order", -1, 0, 60));
+  s.lighting_nodes = static_cast<int>(r.integer("lighting_nodes", 0, 0, 512));
+  if (r.has("environment_eps") && (!has_env || has_order))
+    r.fail("environment_eps", has_env ? "environment_eps measures the band limit, but lighting_order fixes it: remove one"
+                                      : "environment_eps needs environment = \"<lat-long map>\"");
+  if (has_env && (r.has("light") || r.has("intensity")))
+    r.fail(r.has("light") ? "light" : "intensity",
+           "light and intensity describe the point light; with environment the map's radiance lights the sphere");
+  if (has_env && !r.failed()) {
+    std::vector<std::string> tried;
+    s.environment = ctx.resolve(env, &tried);
+    if (s.environment.empty()) {
+      r.fail("environment", "file not found (looked for " + join(tried, ", ") + ")");
+    } else {
+      try {
+        const LatLongMap map = read_latlong(s.environment);
+        const int cap = std::min(60, (map.height - 1) / 2);
+        if (has_order) {
+          if (s.lighting_order > cap)
+            throw std::invalid_argument(s.environment + ": lighting_order " + std::to_string(s.lighting_order) +
+                                        " exceeds the order a " + std::to_string(map.width) + "x" +
+                                        std::to_string(map.height) + " map resolves exactly (" + std::to_string(cap) + ")");
+          ShLighting l = project_latlong(map, s.lighting_order);
+          l.band_limit = s.lighting_order;
+          s.lighting = std::make_shared<const ShLighting>(std::move(l));
+        } else {
+          s.lighting = std::make_shared<const ShLighting>(environment_lighting(map, s.environment_eps, cap));
+        }
+      } catch (const std::exception& e) {
+        r.fail("environment", e.what());
+      }
+    }
+  } else if (has_order && !r.failed()) {
+    const double d2 = s.light.squaredNorm();
+    s.lighting = std::make_shared<const ShLighting>(
+        directional_lighting(s.light, Rgb::Constant(s.intensity / d2), s.lighting_order));
+  }
   r.finish(config_keys("scene"), "[scene]");
   return s;
+}
+
+// The scene's SH lighting band limit L caps SH orders (notes §2.2: F_B =
+// min(F_L, F_rho); BRDF bands above L do not change the shading). Recorded in
+// the options (so in run ids) as lighting_cap.
+void apply_lighting_cap(Plan& plan, Ctx& ctx) {
+  for (auto& m : plan.methods) {
+    if (m.kind == "sh-r" && m.shrm && !plan.scene.lighting)
+      ctx.issue(m.where, "method.shrm",
+                "shrm = true needs SH lighting: set [scene] environment = \"<lat-long map>\" or lighting_order");
+    if (!plan.scene.lighting || (m.kind != "sh-k" && m.kind != "sh-r")) continue;
+    const int L = plan.scene.lighting->order;
+    json& o = m.options;
+    o["lighting_cap"] = L;
+    if (m.kind == "sh-k") {
+      if (m.tolerance) m.cap = std::min(m.cap, L);
+      m.shk.order = std::min(m.shk.order, L);
+      o["order"] = m.shk.order;
+    } else {
+      m.shr.max_order = std::min(m.shr.max_order, L);
+      if (m.shr.order > L) m.shr.order = L;
+      if (m.tolerance) m.cap = std::min(m.cap, L);
+      o["max_order"] = m.shr.max_order;
+      o["order"] = m.shr.order;
+    }
+  }
 }
 
 // Values of [[brdf]] parameters go to the catalogue's ParamDict.
@@ -1403,6 +1482,8 @@ void read_method(Reader& r, Ctx& ctx, const std::string& kind, uint64_t base_see
     k.rim_inset = r.number("rim_inset", k.rim_inset, 0.0, 0.1, true);
     k.min_cos = r.number("min_cos", k.min_cos, 0.0, 1.0, true);
     k.float_textures = r.boolean("float_textures", k.float_textures);
+    // Isotropic BRDFs (azimuthal-invariance test at run time) stored along phi_v = 0 only.
+    o["reduce_isotropic"] = r.boolean("reduce_isotropic", true);
     o["order"] = k.order;
     o["texture_size"] = k.view_res;
     o["theta_nodes"] = k.theta_nodes;
@@ -1485,6 +1566,8 @@ void read_method(Reader& r, Ctx& ctx, const std::string& kind, uint64_t base_see
     s.theta_o_nodes = static_cast<int>(r.integer("theta_o_nodes", 0, 0, 100000));
     s.phi_nodes = static_cast<int>(r.integer("phi_nodes", 0, 0, 100000));
     s.min_cos = r.number("min_cos", s.min_cos, 0.0, 1.0, true);
+    m.shrm = r.boolean("shrm", false);
+    if (m.shrm) o["shrm"] = true;  // absent when false: existing run ids unchanged
     o["max_order"] = s.max_order;
     o["max_view_order"] = s.max_view_order;
     o["order"] = s.order;
@@ -1619,6 +1702,7 @@ Plan parse_plan(const std::string& text, const std::string& path, const std::vec
   read_brdfs(root.get("brdf"), ctx, plan.brdfs);
   read_samplings(root.get("sampling"), ctx, plan.experiment.seed, plan.samplings);
   read_methods(root.get("method"), ctx, plan.experiment.seed, plan.methods);
+  apply_lighting_cap(plan, ctx);
 
   // Combinations that need a measured BRDF.
   for (const auto& s : plan.samplings) {

@@ -13,6 +13,7 @@
 
 #include "brdfs/brdf.h"
 #include "factor/homomorphic_fit.h"
+#include "factor/lighting.h"
 #include "factor/model_fit.h"
 #include "factor/refine.h"
 #include "factor/sh_baseline.h"
@@ -49,12 +50,19 @@ struct ExperimentSettings {
 
 // [scene]: the picture of every run; when the table is present, also the
 // shade_rmse column (DESIGN.md §4). A unit sphere at the origin seen by an
-// orthographic camera on +z, lit by one point light.
+// orthographic camera on +z, lit by one point light, or by band-limited SH
+// lighting (factor/lighting.h) when `environment` or `lighting_order` is set;
+// the SH lighting's order then caps the orders of sh-k and sh-r.
 struct SceneSettings {
   bool named = false;             // the config has a [scene] table
   Vec3 light = Vec3(2.0, 2.0, 4.0);  // light position (world; sphere radius 1)
   double intensity = 20.0;        // radiance = intensity * f * cos(theta_i) / distance^2
   int size = 128;                 // pixels per panel edge
+  std::string environment;        // lat-long map (resolved path); "" = none
+  double environment_eps = 1e-3;  // band limit: smallest L capturing 1 - eps of the map's energy
+  int lighting_order = -1;        // explicit band limit (-1: measured, or point light without a map)
+  int lighting_nodes = 0;         // shading quadrature: theta nodes (0 = auto), phi = 2x
+  std::shared_ptr<const ShLighting> lighting;  // set when the scene is SH-lit
   nlohmann::json identity() const;
 };
 
@@ -94,6 +102,7 @@ struct MethodVariant {
   SvdOptions svd;
   ShkOptions shk;
   ShrOptions shr;
+  bool shrm = false;                 // sh-r: also the SHRM under the scene's SH lighting
   std::optional<Tolerance> tolerance;  // fit, svd, sh-k, sh-r
   // mccool, fit, search: "none" | "linear" | "cosine" | "blend" (factor/refine.h),
   // the refinement stage run after the fit (refine_blend, refine_iterations,

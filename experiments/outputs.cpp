@@ -38,7 +38,7 @@ const std::vector<std::string>& result_columns() {
   static const std::vector<std::string> c = [] {
     std::vector<std::string> v = required_columns();
     for (const char* e : {"label", "sampling", "sweep", "seed", "status", "errors_after_term", "negative_texels",
-                          "order", "view_order", "tolerance", "tolerance_reached", "shade_rmse",
+                          "order", "view_order", "tolerance", "tolerance_reached", "shade_rmse", "isotropic",
                           "refine", "refine_seconds", "rel_mse_before", "rel_mae_before", "rel_max_before",
                           "lin_rmse_before", "lin_mae_before", "lin_max_before", "cos_rmse_before", "model",
                           "notes"})

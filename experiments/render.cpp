@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <optional>
 #include <stdexcept>
 
 namespace bf {
@@ -18,6 +19,9 @@ SphereRender render_sphere(const Brdf& brdf, const SceneSettings& scene) {
   r.L.assign(static_cast<size_t>(n) * n, Rgb::Zero());
   r.inside.assign(static_cast<size_t>(n) * n, 0);
   const Vec3 wo_world(0.0, 0.0, 1.0);
+  // SH-lit scene: the same hemisphere quadrature for every BRDF (factor/lighting.h).
+  std::optional<LitShader> shader;
+  if (scene.lighting) shader.emplace(scene.lighting, scene.lighting_nodes);
   for (int y = 0; y < n; ++y)
     for (int x = 0; x < n; ++x) {
       const double px = -1.0 + (x + 0.5) * 2.0 / n;
@@ -31,6 +35,10 @@ SphereRender render_sphere(const Brdf& brdf, const SceneSettings& scene) {
       if (t.norm() < 1e-9) t = Vec3(0.0, 1.0, 0.0) - nrm.y() * nrm;
       t.normalize();
       const Vec3 b = nrm.cross(t);
+      if (shader) {
+        r.L[k] = shader->shade(brdf, nrm, t, b, wo_world, &r.nonfinite);
+        continue;
+      }
       const Vec3 to_light = scene.light - nrm;
       const double d2 = to_light.squaredNorm();
       const Vec3 wi_world = to_light / std::sqrt(d2);
@@ -45,6 +53,29 @@ SphereRender render_sphere(const Brdf& brdf, const SceneSettings& scene) {
         f = Rgb::Zero();
       }
       r.L[k] = scene.intensity * f * cos_i / d2;
+    }
+  return r;
+}
+
+SphereRender render_sphere_radiance(const std::function<Rgb(const Vec3& n, const Vec3& wo_world)>& radiance,
+                                    int size) {
+  SphereRender r;
+  r.size = size;
+  r.L.assign(static_cast<size_t>(size) * size, Rgb::Zero());
+  r.inside.assign(static_cast<size_t>(size) * size, 0);
+  for (int y = 0; y < size; ++y)
+    for (int x = 0; x < size; ++x) {
+      const double px = -1.0 + (x + 0.5) * 2.0 / size, py = 1.0 - (y + 0.5) * 2.0 / size;
+      const double rr = px * px + py * py;
+      if (rr >= 1.0) continue;
+      const size_t k = static_cast<size_t>(y) * size + x;
+      r.inside[k] = 1;
+      Rgb v = radiance(Vec3(px, py, std::sqrt(1.0 - rr)), Vec3(0.0, 0.0, 1.0));
+      if (!v.isFinite().all()) {
+        ++r.nonfinite;
+        v = Rgb::Zero();
+      }
+      r.L[k] = v;
     }
   return r;
 }

@@ -4,6 +4,7 @@
 // two renders.
 #pragma once
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -26,7 +27,14 @@ struct SphereRender {
   std::vector<uint8_t> inside; // 1 = sphere pixel
   size_t nonfinite = 0;
 };
+// With SH lighting (scene.lighting: [scene] environment or lighting_order)
+// every pixel is instead LitShader::shade (factor/lighting.h): the integral of
+// the band-limited lighting x f x cos over a hemisphere rule, the same rule for
+// the original and the approximation; `nonfinite` then counts BRDF values.
 SphereRender render_sphere(const Brdf& brdf, const SceneSettings& scene);
+// Same sphere and camera, radiance(n, wo_world) per pixel (e.g. an SHRM).
+SphereRender render_sphere_radiance(const std::function<Rgb(const Vec3& n, const Vec3& wo_world)>& radiance,
+                                    int size);
 
 // RMS over the sphere pixels and the three channels of (b - a); 0 when a has
 // no sphere pixel. Throws std::invalid_argument for renders of different size.

@@ -22,6 +22,8 @@
 #include "experiments/cli_util.h"
 #include "experiments/render.h"
 #include "factor/export.h"
+#include "factor/isotropy.h"
+#include "factor/lighting.h"
 #include "factor/metrics.h"
 #include "factor/model_fit.h"
 #include "factor/refine.h"
@@ -263,6 +265,11 @@ RunEntry execute_run(const Plan& plan, const PlannedRun& pr, const SampleSet& sa
   std::optional<SizeChoice> choice;
   const LogTransform lt = LogTransform::of(samples, plan.experiment.metric_eps);
 
+  // Azimuthal-invariance test of the BRDF (factor/isotropy.h): results column `isotropic`.
+  const IsotropyResult isotropy = test_isotropy(*b.brdf);
+  row["isotropic"] = isotropy.isotropic ? "true" : "false";
+  rec["isotropy"] = isotropy.describe();
+
   const auto t0 = Clock::now();
   if (m.kind == "mccool") {
     const FitData data(samples, m.fit.eps);
@@ -318,8 +325,11 @@ RunEntry execute_run(const Plan& plan, const PlannedRun& pr, const SampleSet& sa
     if (m.tolerance) choice = select_svd_rank(*b.brdf, samples, m.svd, *m.tolerance, m.cap);
     else f = fit_svd(*b.brdf, m.svd);
   } else if (m.kind == "sh-k") {
-    if (m.tolerance) choice = select_shk_order(*b.brdf, samples, m.shk, *m.tolerance, m.cap);
-    else f = fit_shk(*b.brdf, m.shk);
+    // An isotropic BRDF (by the azimuthal-invariance test) is stored along phi_v = 0 only.
+    ShkOptions ko = m.shk;
+    ko.reduced = m.options.value("reduce_isotropic", false) && isotropy.isotropic;
+    if (m.tolerance) choice = select_shk_order(*b.brdf, samples, ko, *m.tolerance, m.cap);
+    else f = fit_shk(*b.brdf, ko);
   } else if (m.kind == "sh-r") {
     if (m.tolerance) choice = select_shr_orders_by_metric(*b.brdf, samples, m.shr, *m.tolerance);
     else f = fit_shr(*b.brdf, m.shr);
@@ -464,6 +474,26 @@ RunEntry execute_run(const Plan& plan, const PlannedRun& pr, const SampleSet& sa
     if (approx.nonfinite) notes.push_back(std::to_string(approx.nonfinite) + " non-finite pixels rendered as 0");
     if (plan.scene.named) row["shade_rmse"] = format_number(shade_rmse(*original, approx));
   }
+  // SHRM of an sh-r run under the scene's SH lighting (factor/lighting.h): its
+  // storage, time and shade_rmse against the original's render (same scene).
+  if (m.shrm && plan.scene.lighting)
+    if (auto shr = std::dynamic_pointer_cast<const ShrFactorization>(f)) {
+      const auto t1 = Clock::now();
+      const Shrm shrm(*shr, *plan.scene.lighting);
+      json sj = {{"order", shrm.order()}, {"view_order", shrm.view_order()},
+                 {"storage_floats", shrm.storage_floats()}, {"seconds", shrm.seconds()}};
+      if (plan.experiment.export_factors)
+        write_file_atomic((run_dir / "shrm.json").string(), [&](std::ostream& o) { o << shrm.to_json().dump(1) << "\n"; });
+      const auto original = renders.get(plan, pr.brdf);
+      const SphereRender sr = render_sphere_radiance(
+          [&](const Vec3& n, const Vec3& v) { return shrm.shade(n, v); }, plan.scene.size);
+      const double e = shade_rmse(*original, sr);
+      sj["shade_rmse"] = std::isfinite(e) ? json(e) : json();
+      sj["render_seconds"] = since(t1);
+      rec["shrm"] = sj;
+      notes.push_back("shrm F_B " + std::to_string(shrm.order()) + ", P_B " + std::to_string(shrm.view_order()) + ": " +
+                      std::to_string(shrm.storage_floats()) + " floats, shade_rmse " + format_number(e));
+    }
   row["notes"] = join(notes, "; ");
   rec["notes"] = notes;
   rec["wall_seconds"] = since(wall0);
