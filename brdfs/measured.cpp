@@ -207,11 +207,22 @@ SpectralOptions read_spectral_options(const ParamDict& options) {
   return o;
 }
 
+// A MeasuredBrdf from a file's samples; errors (e.g. every sample masked) name
+// the file.
+BrdfPtr make_measured(const std::string& path, const std::string& name, SampleSet samples,
+                      const MeasuredOptions& o) {
+  try {
+    return std::make_shared<MeasuredBrdf>(name, std::move(samples), o);
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument(path + ": " + e.what());
+  }
+}
+
 // Reads a spectral file (.astm or .brdf) into a MeasuredBrdf.
 BrdfPtr load_spectral(const std::string& path, const SpectralOptions& o, const std::string& name,
                       bool astm) {
   const SpectralMeasurements m = astm ? read_astm(path) : read_pbrt_brdf(path);
-  return std::make_shared<MeasuredBrdf>(name, spectral_to_samples(m, o.band), o.measured);
+  return make_measured(path, name, spectral_to_samples(m, o.band), o.measured);
 }
 
 const std::vector<ParamInfo> kSpectralParams = {
@@ -252,7 +263,7 @@ void register_measured_loaders(Catalogue& cat) {
   cat.add_loader(".csv", [](const std::string& path, const ParamDict& options) -> BrdfPtr {
     const MeasuredOptions o = read_measured_options(options);
     options.check_unused("the .csv loader", {"k"});
-    return std::make_shared<MeasuredBrdf>("csv", read_sample_csv(path), o);
+    return make_measured(path, "csv", read_sample_csv(path), o);
   });
   cat.add_loader(".binary", [](const std::string& path, const ParamDict& options) -> BrdfPtr {
     const MerlLookup lookup =
