@@ -2,6 +2,7 @@
 // methods), prints one line per result and optionally a CSV; exit code 1 when
 // an expectation fails.
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <iostream>
@@ -15,6 +16,15 @@
 namespace bf {
 
 namespace {
+
+// A table cell: the value with `digits` significant digits, "-" when it was not
+// computed (NaN; no output ever shows "nan").
+std::string cell(double v, int digits) {
+  if (std::isnan(v)) return "-";
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.*g", digits, v);
+  return buf;
+}
 
 struct StressArgs {
   StressOptions opt;
@@ -100,9 +110,10 @@ int run(const StressArgs& a) {
     for (const std::string& m : stress_methods()) {
       StressResult r = run_stress(c, in, m, a.opt);
       all_pass = all_pass && r.pass;
-      std::printf("%-18s %-8s %-6s %11.4g %11.4g %10.3g %7.2f %-16s %s%s\n", r.case_name.c_str(),
-                  r.method.c_str(), r.threw ? "error" : r.finite ? "yes" : "NO", r.rel_mse, r.cos_rmse,
-                  r.condition, r.seconds, r.expectation.c_str(), r.pass ? "pass" : "FAIL",
+      std::printf("%-18s %-8s %-6s %11s %11s %10s %7.2f %-16s %s%s\n", r.case_name.c_str(),
+                  r.method.c_str(), r.threw ? "error" : r.finite ? "yes" : "NO", cell(r.rel_mse, 4).c_str(),
+                  cell(r.cos_rmse, 4).c_str(), cell(r.condition, 3).c_str(), r.seconds,
+                  r.expectation.c_str(), r.pass ? "pass" : "FAIL",
                   r.threw ? ("  (" + r.message + ")").c_str() : "");
       std::fflush(stdout);
       results.push_back(std::move(r));

@@ -6,6 +6,7 @@
 
 #include "brdfs/catalogue.h"
 #include "factor/stress.h"
+#include "test_common.h"
 
 using namespace bf;
 
@@ -90,4 +91,30 @@ TEST_CASE("stress: options are validated with the field named") {
   o = StressOptions{};
   o.samples = 3;
   REQUIRE_THROWS_WITH(o.validate(), Catch::Contains("samples: expected"));
+}
+
+TEST_CASE("stress: the CLI table prints '-' for values it did not compute, never nan") {
+  // all-zero: every method refuses (no rel_mse, no cos_rmse); --cond-max 1: no
+  // condition estimate anywhere.
+  bf_test::TempDir d("stress_cli");
+  const std::string out = d.file("stdout.txt"), csv = d.file("stress.csv");
+  std::string cmd = BF_CLI_PATH;
+  cmd.append(" stress --case all-zero --samples 300 --res 8 --svd-res 8 --cond-max 1 --out ")
+      .append(csv)
+      .append(" > ")
+      .append(out);
+  const int status = std::system(cmd.c_str());
+  REQUIRE(WIFEXITED(status));
+  CHECK(WEXITSTATUS(status) == 0);
+  const std::string text = bf_test::slurp(out);
+  INFO(text);
+  CHECK(text.find("all-zero") != std::string::npos);
+  std::string lower = text;
+  std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char ch) { return std::tolower(ch); });
+  CHECK(lower.find("nan") == std::string::npos);
+  CHECK(lower.find(" inf") == std::string::npos);
+  CHECK(text.find(" - ") != std::string::npos);
+  const std::string table = bf_test::slurp(csv);
+  CHECK(table.find("all-zero") != std::string::npos);
+  CHECK(table.find("nan") == std::string::npos);
 }
