@@ -12,7 +12,7 @@ namespace {
 const std::vector<std::string> kExamples = {
     "quickstart",      "thesis-bluepaint", "thesis-cook-torrance", "thesis-setup",
     "thesis-measured", "parameterizations", "baselines",          "bench-fit",
-    "bench-search",    "bench-baselines"};
+    "bench-search",    "bench-baselines", "refine"};
 
 // Runs experiments/<name>.toml with the overrides; every run must succeed.
 void run_example(const std::string& name, const std::vector<std::string>& defines, size_t expected_runs) {
@@ -111,4 +111,11 @@ TEST_CASE("examples: bench-baselines at reduced size") {
               {"sampling.count=1500", "method.texture_size=6", "method.order=[2, 4]", "method[4].order=[2, 4]",
                "method[4].view_order=[2, 3]", "method.max_order=6", "method.max_view_order=4"},
               10);
+}
+
+TEST_CASE("examples: refine at reduced size") {
+  run_example("refine",
+              {"sampling.resolution=5", "method.texture_size=6", "method.refine_iterations=3", "method.starts=1",
+               "method.max_iterations=5"},
+              48);
 }
