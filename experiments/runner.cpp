@@ -21,6 +21,7 @@
 #include "brdfs/sampleset.h"
 #include "experiments/cli_util.h"
 #include "experiments/render.h"
+#include "experiments/preflight.h"
 #include "factor/export.h"
 #include "factor/isotropy.h"
 #include "factor/lighting.h"
@@ -643,6 +644,12 @@ RunSummary run_experiment(const RunOptions& opt, std::ostream& out, std::ostream
     return sum;
   }
 
+  {  // Before any work: the folder is writable and has room (experiments/preflight.h).
+    std::vector<bool> todo_runs(plan.runs.size());
+    for (size_t i = 0; i < plan.runs.size(); ++i)
+      todo_runs[i] = action[i] != Action::Cached && action[i] != Action::OtherShard;
+    check_output_folder(dir, estimate_output_bytes(plan, todo_runs));
+  }
   fs::create_directories(exp_dir / "runs");
   const int jobs_cfg = opt.jobs >= 0 ? opt.jobs : plan.experiment.jobs;
   const int jobs = jobs_cfg > 0 ? jobs_cfg : hardware_cores();
