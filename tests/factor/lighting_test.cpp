@@ -216,8 +216,9 @@ TEST_CASE("lighting: SHRM B_lmpq reproduces the lit integral of the sh-r series 
 // (smoothstep over z in [-0.3, 0.3]) plus a sun lobe 20 exp((w.s - 1)/0.02)
 // towards s = normalize(0.5, 0.3, 0.8). Its band limit is measured, not known.
 TEST_CASE("lighting: write the example environment map", "[.write-env]") {
+  // ctest's "~[slow]" spec also selects hidden tests: without the variable it does nothing.
   const char* dir = std::getenv("BF_WRITE_ENV_DIR");
-  REQUIRE(dir != nullptr);
+  if (dir == nullptr) return;
   const Vec3 sun = Vec3(0.5, 0.3, 0.8).normalized();
   const LatLongMap m = make_latlong(128, 64, [&](const Vec3& w) {
     const double t = std::clamp((w.z() + 0.3) / 0.6, 0.0, 1.0), h = t * t * (3 - 2 * t);
