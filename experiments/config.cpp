@@ -107,10 +107,10 @@ const std::map<std::string, std::vector<std::string>>& key_table() {
       {"brdf", {"preset", "model", "file", "name", "zip"}},
       {"projection", {"parameterization", "matrix", "name", "reciprocal"}},
       {"tolerance", {"metric", "value"}},
-      {"method:mccool", join_keys({kCommonMethodKeys, kFitKeys, kRefineKeys, {"terms"}})},
+      {"method:mccool", join_keys({kCommonMethodKeys, kFitKeys, kRefineKeys, {"terms", "tolerance", "texture_ladder"}})},
       {"method:fit", join_keys({kCommonMethodKeys, kFitKeys, kRefineKeys,
                                 {"projections", "terms", "parameterization", "reciprocity",
-                                 "tolerance"}})},
+                                 "tolerance", "texture_ladder"}})},
       {"method:search",
        join_keys({kCommonMethodKeys, kFitKeys, kRefineKeys,
                   {"parameterization", "terms", "search_texture_size", "restarts", "guesses",
@@ -120,7 +120,7 @@ const std::map<std::string, std::vector<std::string>>& key_table() {
       {"method:svd", join_keys({kCommonMethodKeys,
                                 {"texture_size", "terms", "parameterization", "log", "eps",
                                  "subtract_eps", "rim_inset", "extend_below_horizon",
-                                 "float_textures", "tolerance"}})},
+                                 "float_textures", "tolerance", "texture_ladder"}})},
       {"method:sh-k", join_keys({kCommonMethodKeys,
                                  {"order", "texture_size", "theta_nodes", "phi_nodes", "rim_inset",
                                   "min_cos", "float_textures", "tolerance", "reduce_isotropic"}})},
@@ -1144,7 +1144,7 @@ void read_samplings(const toml::node* node, Ctx& ctx, uint64_t base_seed,
 // ------------------------------------------------------------------ methods
 
 bool method_array_is_value(const std::string& key, const toml::array& a) {
-  if (key == "guesses" || key == "projections") return !all_arrays(a);
+  if (key == "guesses" || key == "projections" || key == "texture_ladder") return !all_arrays(a);
   return false;
 }
 
@@ -1172,6 +1172,55 @@ void read_fit_options(Reader& r, FitOptions& f, json& o) {
 Parameterization read_param(Reader& r, const std::string& key, Parameterization def) {
   const std::string s = r.choice(key, to_string(def), {"wiwo", "halfdiff"});
   return parse_parameterization(s);
+}
+
+// texture_size: an integer lo..hi, or "auto": the resolution is then chosen by
+// the method's tolerance from texture_ladder (default 8, 12, 16, 24, 32;
+// ascending integers in lo..hi), filled into m.texture_ladder. Returns the
+// fixed size, or the ladder's largest entry for "auto"; sets o's entries.
+int read_texture_size(Reader& r, MethodVariant& m, json& o, int def, int lo, int hi) {
+  const std::string range = "in " + std::to_string(lo) + ".." + std::to_string(hi);
+  int size = def;
+  bool is_auto = false;
+  if (const toml::node* n = r.take("texture_size")) {
+    auto str = n->as_string();
+    auto v = n->as_integer();
+    if (str && str->get() == "auto") is_auto = true;
+    else if (v && v->get() >= lo && v->get() <= hi) size = static_cast<int>(v->get());
+    else r.fail("texture_size", "expected an integer " + range + " or \"auto\", " + found(*n));
+  }
+  std::vector<int> ladder = default_texture_ladder();
+  if (const toml::node* l = r.take("texture_ladder")) {
+    if (!is_auto) r.fail("texture_ladder", "texture_ladder applies only with texture_size = \"auto\"");
+    const auto* a = l->as_array();
+    if (!a || a->empty()) {
+      r.fail("texture_ladder", "expected a non-empty list of integers " + range + ", e.g. [8, 12, 16, 24, 32], " + found(*l));
+    } else {
+      ladder.clear();
+      for (const auto& e : *a) {
+        auto i = e.as_integer();
+        if (!i || i->get() < lo || i->get() > hi) {
+          r.fail("texture_ladder", "expected integers " + range + ", found an element " + show(e));
+          break;
+        }
+        if (!ladder.empty() && i->get() <= ladder.back()) {
+          r.fail("texture_ladder", "expected strictly ascending resolutions, found " + std::to_string(i->get()) +
+                                       " after " + std::to_string(ladder.back()));
+          break;
+        }
+        ladder.push_back(static_cast<int>(i->get()));
+      }
+    }
+  }
+  if (is_auto) {
+    if (!ladder.empty()) size = ladder.back();
+    m.texture_ladder = ladder;
+    o["texture_size"] = "auto";
+    o["texture_ladder"] = ladder;
+  } else {
+    o["texture_size"] = size;
+  }
+  return size;
 }
 
 std::optional<Tolerance> read_tolerance(Reader& r, Ctx& ctx) {
@@ -1326,22 +1375,25 @@ void read_method(Reader& r, Ctx& ctx, const std::string& kind, uint64_t base_see
   };
 
   if (kind == "mccool") {
-    m.texture_size = static_cast<int>(r.integer("texture_size", 16, 2, 1024));
+    m.texture_size = read_texture_size(r, m, o, 16, 2, 1024);
+    m.tolerance = read_tolerance(r, ctx);
+    if (m.tolerance) o["tolerance"] = {{"metric", m.tolerance->metric}, {"value", m.tolerance->value}};
+    if (m.tolerance && m.texture_ladder.empty())
+      r.fail("tolerance", "kind = \"mccool\" has exactly 2 textures: a tolerance can only choose the resolution "
+                          "(set texture_size = \"auto\")");
     if (const toml::node* tn = r.take("terms"); tn && !(tn->is_integer() && tn->as_integer()->get() == 2))
       r.fail("terms", "kind = \"mccool\" has exactly 2 textures (p(wi)/p(wo) shared, and p(h)), found " +
                           show(*tn));
     m.terms = 2;
     read_fit_options(r, m.fit, o);
     m.param = Parameterization::WiWo;
-    o["texture_size"] = m.texture_size;
     o["terms"] = 2;
   } else if (kind == "fit") {
-    m.texture_size = static_cast<int>(r.integer("texture_size", 16, 2, 1024));
+    m.texture_size = read_texture_size(r, m, o, 16, 2, 1024);
     m.param = read_param(r, "parameterization", Parameterization::WiWo);
     m.reciprocity = r.boolean("reciprocity", false);
     read_fit_options(r, m.fit, o);
     m.tolerance = read_tolerance(r, ctx);
-    o["texture_size"] = m.texture_size;
     o["parameterization"] = to_string(m.param);
     o["reciprocity"] = m.reciprocity;
     read_projections(r, ctx, m, o);
@@ -1353,6 +1405,8 @@ void read_method(Reader& r, Ctx& ctx, const std::string& kind, uint64_t base_see
     o["terms"] = m.terms;
     cap_terms(n);
     if (m.tolerance) o["tolerance"] = {{"metric", m.tolerance->metric}, {"value", m.tolerance->value}};
+    if (!m.texture_ladder.empty() && !m.tolerance)
+      r.fail("texture_size", "texture_size = \"auto\" needs a tolerance (the error target that picks the size)");
   } else if (kind == "search") {
     SearchOptions& s = m.search;
     m.param = read_param(r, "parameterization", s.param);
@@ -1431,7 +1485,7 @@ void read_method(Reader& r, Ctx& ctx, const std::string& kind, uint64_t base_see
     }
   } else if (kind == "svd") {
     SvdOptions& v = m.svd;
-    m.texture_size = static_cast<int>(r.integer("texture_size", v.res, 2, 256));
+    m.texture_size = read_texture_size(r, m, o, v.res, 2, 256);
     m.tolerance = read_tolerance(r, ctx);
     m.terms = static_cast<int>(r.integer("terms", m.tolerance ? 16 : v.rank, 1, 100000));
     m.param = read_param(r, "parameterization", v.param);
@@ -1444,13 +1498,12 @@ void read_method(Reader& r, Ctx& ctx, const std::string& kind, uint64_t base_see
         }
     v.eps = r.number("eps", v.eps, 0.0, 1.0, true);
     v.subtract_eps = r.boolean("subtract_eps", v.subtract_eps);
-    v.rim_inset = r.number("rim_inset", v.rim_inset, 0.0, 0.1, true);
+    v.rim_inset = r.number("rim_inset", v.rim_inset, 0.0, 0.5);  // 0: half a texel (SvdOptions)
     v.extend_below_horizon = r.boolean("extend_below_horizon", v.extend_below_horizon);
     v.float_textures = r.boolean("float_textures", v.float_textures);
     v.res = m.texture_size;
     v.rank = m.terms;
     v.param = m.param;
-    o["texture_size"] = v.res;
     o["terms"] = v.rank;
     o["parameterization"] = to_string(v.param);
     o["log"] = v.log;
@@ -1462,6 +1515,8 @@ void read_method(Reader& r, Ctx& ctx, const std::string& kind, uint64_t base_see
     if (m.tolerance) {
       m.cap = m.terms;
       o["tolerance"] = {{"metric", m.tolerance->metric}, {"value", m.tolerance->value}};
+    } else if (!m.texture_ladder.empty()) {
+      r.fail("texture_size", "texture_size = \"auto\" needs a tolerance (the error target that picks the size)");
     }
     m.cores = hardware_cores();
     if (!r.failed()) {

@@ -111,6 +111,9 @@ struct MethodVariant {
   RefineOptions refine_options;
   ModelFitOptions model_fit;           // model-fit
   int cap = 0;              // with a tolerance: the largest terms / order tried
+  // texture_size = "auto" (mccool, fit, svd; needs a tolerance): the
+  // resolutions tried, ascending (key texture_ladder); empty = fixed texture_size.
+  std::vector<int> texture_ladder;
   uint64_t seed = 0;        // search seed (0 when the kind has none)
   int cores = 1;            // cores the method keeps busy by itself (scheduling, runner.h)
 };

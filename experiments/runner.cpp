@@ -28,6 +28,7 @@
 #include "factor/metrics.h"
 #include "factor/model_fit.h"
 #include "factor/refine.h"
+#include "factor/size_select.h"
 #if __has_include("brdfs/measured.h")
 #include "brdfs/measured.h"
 #define BF_HAVE_MEASURED 1
@@ -272,32 +273,25 @@ RunEntry execute_run(const Plan& plan, const PlannedRun& pr, const SampleSet& sa
   rec["isotropy"] = isotropy.describe();
 
   const auto t0 = Clock::now();
+  // With texture_size = "auto", the tolerance picks the resolution from the
+  // ladder too (factor/size_select.h); otherwise the ladder is the one size.
+  const std::vector<int> ladder = m.texture_ladder.empty() ? std::vector<int>{m.texture_size} : m.texture_ladder;
   if (m.kind == "mccool") {
     const FitData data(samples, m.fit.eps);
-    h = fit_homomorphic(data, mccool_terms(m.texture_size), m.fit, "mccool", &errs);
+    if (m.tolerance) {
+      choice = select_homomorphic_size(data, samples, lt, mccool_terms, 2, 2, m.fit, "mccool", *m.tolerance, ladder);
+      h = std::dynamic_pointer_cast<const HomomorphicFactorization>(choice->result);
+      errs = choice->errors_after_term;
+    } else {
+      h = fit_homomorphic(data, mccool_terms(m.texture_size), m.fit, "mccool", &errs);
+    }
   } else if (m.kind == "fit") {
     const FitData data(samples, m.fit.eps);
     if (m.tolerance) {
-      SizeChoice c;
-      c.method = "fit";
-      c.knob = "terms";
-      c.metric = m.tolerance->metric;
-      for (int j = 1; j <= m.cap; ++j) {
-        std::vector<double> ej;
-        auto hj = fit_homomorphic(data, std::vector<TermSpec>(m.projections.begin(), m.projections.begin() + j),
-                                  m.fit, "fit", &ej);
-        const double v = metric_value(evaluate_metrics(*hj, samples, lt), c.metric);
-        c.tried.push_back({j, -1, v});
-        h = hj;
-        errs = ej;
-        c.value = j;
-        c.error = v;
-        if (v <= m.tolerance->value) {
-          c.reached = true;
-          break;
-        }
-      }
-      choice = c;
+      const auto terms_at = [&](int res) { return terms_at_resolution(m.projections, res); };
+      choice = select_homomorphic_size(data, samples, lt, terms_at, 1, m.cap, m.fit, "fit", *m.tolerance, ladder);
+      h = std::dynamic_pointer_cast<const HomomorphicFactorization>(choice->result);
+      errs = choice->errors_after_term;
     } else {
       h = fit_homomorphic(data, std::vector<TermSpec>(m.projections.begin(), m.projections.begin() + m.terms),
                           m.fit, "fit", &errs);
@@ -323,8 +317,12 @@ RunEntry execute_run(const Plan& plan, const PlannedRun& pr, const SampleSet& sa
       rec["best_branch"] = sr.best_branch;
     }
   } else if (m.kind == "svd") {
-    if (m.tolerance) choice = select_svd_rank(*b.brdf, samples, m.svd, *m.tolerance, m.cap);
-    else f = fit_svd(*b.brdf, m.svd);
+    if (m.tolerance && !m.texture_ladder.empty())
+      choice = select_svd_size(*b.brdf, samples, m.svd, *m.tolerance, m.cap, m.texture_ladder);
+    else if (m.tolerance)
+      choice = select_svd_rank(*b.brdf, samples, m.svd, *m.tolerance, m.cap);
+    else
+      f = fit_svd(*b.brdf, m.svd);
   } else if (m.kind == "sh-k") {
     // An isotropic BRDF (by the azimuthal-invariance test) is stored along phi_v = 0 only.
     ShkOptions ko = m.shk;
@@ -395,7 +393,7 @@ RunEntry execute_run(const Plan& plan, const PlannedRun& pr, const SampleSet& sa
     // (McCool's p(h) texture), so the approximation is reciprocal.
     row["reciprocity"] = recip == 0 ? "false" : symmetric == h->terms().size() ? "true" : "mixed";
     row["terms"] = std::to_string(h->terms().size());
-    row["texture_size"] = std::to_string(m.texture_size);
+    row["texture_size"] = std::to_string(choice && choice->texture_size ? choice->texture_size : m.texture_size);
     std::vector<std::string> ec;
     for (double v : errs) ec.push_back(format_number(v));
     row["errors_after_term"] = join(ec, ";");
@@ -450,12 +448,17 @@ RunEntry execute_run(const Plan& plan, const PlannedRun& pr, const SampleSet& sa
     if (!choice->reached)
       notes.push_back("tolerance not reached up to the cap; best tried: " + format_number(choice->error));
     json tried = json::array();
-    for (const auto& t : choice->tried) tried.push_back({{"value", t.value}, {"view_order", t.view_order},
-                                                         {"error", std::isfinite(t.error) ? json(t.error) : json()}});
+    for (const auto& t : choice->tried) {
+      json tj = {{"value", t.value}, {"view_order", t.view_order},
+                 {"error", std::isfinite(t.error) ? json(t.error) : json()}};
+      if (t.texture_size) tj["texture_size"] = t.texture_size;
+      tried.push_back(tj);
+    }
     rec["size_choice"] = {{"knob", choice->knob.empty() ? "terms" : choice->knob}, {"value", choice->value},
                           {"view_order", choice->view_order}, {"metric", choice->metric},
                           {"error", std::isfinite(choice->error) ? json(choice->error) : json()},
                           {"reached", choice->reached}, {"seconds", choice->seconds}, {"tried", tried}};
+    if (choice->texture_size) rec["size_choice"]["texture_size"] = choice->texture_size;
   }
 
   // Files.
