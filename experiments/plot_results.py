@@ -8,6 +8,10 @@ Writes into --out (default: plots/ beside the CSV), one file per figure:
                     a whole curve, others one point at their `terms`
   error_vs_seconds  error against run time, all runs, with the Pareto front
   error_vs_storage  error against storage_floats (floats a renderer holds)
+  by_brdf_<metric>  one row of panels per BRDF: error against storage_floats
+                    (left) and against seconds (right), one marker and colour per
+                    method label, log axes; for --metric and for cos_rmse (the
+                    fair metric when SH methods, which represent f cos, take part)
 Prints "wrote PATH" per file on stdout; exits 0 with nothing written when no row
 has the error column. Needs matplotlib (Debian: python3-matplotlib).
 
@@ -68,6 +72,57 @@ def pareto(points):
             front.append((x, y))
             best = y
     return front
+
+
+MARKERS = ["o", "s", "^", "D", "v", "P", "X", "<", ">", "*", "h", "p"]
+
+
+def plot_by_brdf(plt, all_rows, metric, out_dir, formats):
+    rows = [r for r in all_rows if number(r.get(metric)) is not None and number(r[metric]) > 0]
+    if not rows:
+        return []
+    brdfs = list(OrderedDict.fromkeys(r["brdf"] for r in rows))
+    labels = list(OrderedDict.fromkeys(r.get("label") or r["method"] for r in rows))
+    style = {lab: (MARKERS[i % len(MARKERS)], "C%d" % (i % 10)) for i, lab in enumerate(labels)}
+    columns = (("storage_floats", "storage (floats)"), ("seconds", "seconds (method wall time)"))
+    fig, axes = plt.subplots(len(brdfs), 2, figsize=(11.5, 3.6 * len(brdfs)), squeeze=False)
+    for i, brdf in enumerate(brdfs):
+        for j, (column, xlabel) in enumerate(columns):
+            ax = axes[i][j]
+            for lab in labels:
+                pts = sorted((number(r.get(column)), number(r[metric])) for r in rows
+                             if r["brdf"] == brdf and (r.get("label") or r["method"]) == lab
+                             and number(r.get(column)) is not None and number(r.get(column)) > 0)
+                if not pts:
+                    continue
+                marker, colour = style[lab]
+                # Storage grows with the size knob, so a line there follows one
+                # method's sizes; times are noisy, so that panel has markers only.
+                ax.plot([p[0] for p in pts], [p[1] for p in pts], marker=marker, color=colour,
+                        linestyle="-" if column == "storage_floats" else "none", linewidth=0.8,
+                        markersize=5, label=lab)
+            ax.set_xscale("log")
+            ax.set_yscale("log")
+            ax.set_xlabel(xlabel)
+            ax.set_ylabel(metric)
+            ax.set_title(brdf, fontsize=10)
+            ax.grid(True, which="both", alpha=0.25)
+    handles, names = [], []
+    for row in axes:
+        for ax in row:
+            for h, n in zip(*ax.get_legend_handles_labels()):
+                if n not in names:
+                    handles.append(h)
+                    names.append(n)
+    fig.tight_layout()
+    legend_rows = (len(names) + 3) // 4
+    fig.subplots_adjust(top=1.0 - (0.45 + 0.22 * legend_rows) / (3.6 * len(brdfs)))
+    fig.legend(handles, names, loc="upper center", ncol=min(4, max(1, len(names))), fontsize=8,
+               bbox_to_anchor=(0.5, 1.0 - 0.25 / (3.6 * len(brdfs))), frameon=False)
+    fig.suptitle(metric + " against storage and time, per BRDF (log axes)", y=1.0)
+    out = save(fig, out_dir, "by_brdf_" + metric, formats)
+    plt.close(fig)
+    return out
 
 
 def main():
@@ -167,6 +222,10 @@ def main():
         ax.set_title(a.metric + " against " + column)
         written += save(fig, out_dir, stem, formats)
         plt.close(fig)
+
+    # 4. per BRDF: error against storage and against time, one marker per method.
+    for metric in OrderedDict.fromkeys([a.metric, "cos_rmse"]):
+        written += plot_by_brdf(plt, load(a.csv), metric, out_dir, formats)
 
     for w in written:
         print("wrote " + w)

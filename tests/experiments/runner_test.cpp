@@ -285,7 +285,14 @@ TEST_CASE("runner: every link and image of report.html resolves") {
       CHECK(std::find(links.begin(), links.end(), "runs/" + id + "/" + name) != links.end());
     }
   if (!find_python(nullptr).empty()) {
-    CHECK(s.files.plots.size() == 3);
+    // error_vs_terms, error_vs_seconds, error_vs_storage, by_brdf_rel_mse, by_brdf_cos_rmse
+    CHECK(s.files.plots.size() == 5);
+    const auto has_plot = [&](const std::string& stem) {
+      return std::any_of(s.files.plots.begin(), s.files.plots.end(),
+                         [&](const std::string& p) { return p.find(stem) != std::string::npos; });
+    };
+    CHECK(has_plot("by_brdf_rel_mse"));
+    CHECK(has_plot("by_brdf_cos_rmse"));
     for (const auto& p : s.files.plots) CHECK(std::find(links.begin(), links.end(), p) != links.end());
   } else {
     WARN("no python3 with matplotlib: plots not checked (" << s.files.plots_note << ")");
