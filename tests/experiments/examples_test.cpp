@@ -12,7 +12,8 @@ namespace {
 const std::vector<std::string> kExamples = {
     "quickstart",      "thesis-bluepaint", "thesis-cook-torrance", "thesis-setup",
     "thesis-measured", "parameterizations", "baselines",          "bench-fit",
-    "bench-search",    "bench-baselines", "refine"};
+    "bench-search",    "bench-baselines", "refine",   "compare-storage",
+    "sh-lighting",     "thesis-nongreedy", "thesis-bluepaint-mccool"};
 
 // Runs experiments/<name>.toml with the overrides; every run must succeed.
 void run_example(const std::string& name, const std::vector<std::string>& defines, size_t expected_runs) {
@@ -118,4 +119,16 @@ TEST_CASE("examples: refine at reduced size") {
               {"sampling.resolution=5", "method.texture_size=6", "method.refine_iterations=3", "method.starts=1",
                "method.max_iterations=5"},
               48);
+}
+
+TEST_CASE("examples: compare-storage at reduced size") {
+  // 3 BRDFs x (mccool 2 sizes + search 1 + 3 svd x 2 ranks + sh-k 2 orders + svd auto + mccool auto) = 39
+  run_example("compare-storage",
+              {"sampling.count=1500", "method[0].texture_size=[4, 6]", "method[1].texture_size=6",
+               "method[1].search_texture_size=0", "method[1].restarts=1", "method[1].terms=2",
+               "method[2].texture_size=6", "method[2].terms=[1, 2]", "method[3].texture_size=6",
+               "method[3].terms=[1, 2]", "method[4].texture_size=6", "method[4].terms=[1, 2]",
+               "method[5].texture_size=6", "method[5].order=[2, 3]", "method[6].texture_ladder=[4, 6]",
+               "method[6].terms=3", "method[7].texture_ladder=[4, 6]"},
+              39);
 }
