@@ -185,7 +185,8 @@ def main():
             ax.set_yscale("log")
         ax.grid(True, alpha=0.3)
         if series:
-            ax.legend(fontsize=7)
+            # Below the panel, so no curve is hidden (savefig's tight box keeps it).
+            ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.2), frameon=False)
     for j in range(n, nrows * cols):
         axes[j // cols][j % cols].axis("off")
     if any_curve:
@@ -218,7 +219,8 @@ def main():
         ax.set_xlabel(xlabel)
         ax.set_ylabel(a.metric)
         ax.grid(True, alpha=0.3)
-        ax.legend(fontsize=7)
+        ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.14), frameon=False,
+                  ncol=2 if len(groups) > 8 else 1)
         ax.set_title(a.metric + " against " + column)
         written += save(fig, out_dir, stem, formats)
         plt.close(fig)

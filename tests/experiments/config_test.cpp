@@ -9,45 +9,17 @@ using namespace bf_test;
 
 namespace {
 
-const char* kBase = R"([experiment]
-name = "t"
-
-[[brdf]]
-preset = "bluepaint"
-
-[sampling]
-kind = "grid"
-resolution = 6
-)";
+const char* const kBase = kConfigHead;
 
 Plan plan_of(const std::string& text, std::vector<std::string> defines = {}) {
   register_loaders();
   return parse_plan(text, "cfg.toml", defines);
 }
 
-// Messages of the ConfigError thrown for `text` (empty if it validates).
-std::vector<std::string> errors_of(const std::string& text, std::vector<std::string> defines = {}) {
-  try {
-    plan_of(text, defines);
-  } catch (const ConfigError& e) {
-    return e.messages();
-  }
-  return {};
-}
-
 std::string all(const std::vector<std::string>& v) {
   std::string s;
   for (const auto& m : v) s += m + "\n";
   return s;
-}
-
-// Exactly one message, which contains every fragment.
-void require_one(const std::string& text, std::initializer_list<std::string> fragments,
-                 std::vector<std::string> defines = {}) {
-  const auto errs = errors_of(text, defines);
-  INFO(all(errs));
-  REQUIRE(errs.size() == 1);
-  for (const auto& f : fragments) CHECK(errs[0].find(f) != std::string::npos);
 }
 
 }  // namespace
@@ -72,117 +44,117 @@ restarts = 1
 }
 
 TEST_CASE("config: each rule broken gives one message with file:line, field and rule") {
-  SECTION("TOML syntax") { require_one("[experiment\nname = 1\n", {"cfg.toml:1:", "TOML"}); }
+  SECTION("TOML syntax") { require_one_config_error("[experiment\nname = 1\n", {"cfg.toml:1:", "TOML"}); }
   SECTION("unknown section") {
-    require_one(std::string(kBase) + "[[method]]\nkind = \"mccool\"\n[samplin]\nx = 1\n",
+    require_one_config_error(std::string(kBase) + "[[method]]\nkind = \"mccool\"\n[samplin]\nx = 1\n",
                 {"cfg.toml:", "samplin", "unknown section", "did you mean 'sampling'"});
   }
   SECTION("unknown key, with a suggestion") {
-    require_one(std::string(kBase) + "[[method]]\nkind = \"search\"\nrestrats = 2\n",
+    require_one_config_error(std::string(kBase) + "[[method]]\nkind = \"search\"\nrestrats = 2\n",
                 {"cfg.toml:12: method[0].restrats: unknown key", "did you mean 'restarts'"});
   }
   SECTION("a key of another kind") {
-    require_one(std::string(kBase) + "[[method]]\nkind = \"mccool\"\nrestarts = 2\n",
+    require_one_config_error(std::string(kBase) + "[[method]]\nkind = \"mccool\"\nrestarts = 2\n",
                 {"cfg.toml:12: method[0].restarts: does not apply to kind = \"mccool\"", "search"});
   }
   SECTION("wrong type") {
-    require_one(std::string(kBase) + "[[method]]\nkind = \"search\"\nterms = \"two\"\n",
+    require_one_config_error(std::string(kBase) + "[[method]]\nkind = \"search\"\nterms = \"two\"\n",
                 {"cfg.toml:12: method[0].terms: expected an integer in 1..64, found \"two\" (a string)"});
   }
   SECTION("out of range") {
-    require_one("[[brdf]]\npreset = \"bluepaint\"\n[sampling]\nresolution = 1\n[[method]]\nkind = \"mccool\"\n",
+    require_one_config_error("[[brdf]]\npreset = \"bluepaint\"\n[sampling]\nresolution = 1\n[[method]]\nkind = \"mccool\"\n",
                 {"cfg.toml:4: sampling.resolution: expected an integer in 2..256, found 1"});
   }
   SECTION("float out of range") {
-    require_one(std::string(kBase) + "[[method]]\nkind = \"mccool\"\neps = 0\n",
+    require_one_config_error(std::string(kBase) + "[[method]]\nkind = \"mccool\"\neps = 0\n",
                 {"cfg.toml:12: method[0].eps: expected a number in (0, 1], found 0"});
   }
   SECTION("unknown choice") {
-    require_one(std::string(kBase) + "[[method]]\nkind = \"search\"\nparameterization = \"halfdif\"\n",
+    require_one_config_error(std::string(kBase) + "[[method]]\nkind = \"search\"\nparameterization = \"halfdif\"\n",
                 {"cfg.toml:12: method[0].parameterization: expected one of \"wiwo\", \"halfdiff\"",
                  "did you mean 'halfdiff'"});
   }
   SECTION("missing file") {
-    require_one("[[brdf]]\nfile = \"no/such/file.astm\"\n[[method]]\nkind = \"mccool\"\n",
+    require_one_config_error("[[brdf]]\nfile = \"no/such/file.astm\"\n[[method]]\nkind = \"mccool\"\n",
                 {"cfg.toml:2: brdf[0].file: file not found"});
   }
   SECTION("missing sample file") {
-    require_one("[[brdf]]\npreset = \"bluepaint\"\n[sampling]\nkind = \"file\"\npath = \"nope.csv\"\n"
+    require_one_config_error("[[brdf]]\npreset = \"bluepaint\"\n[sampling]\nkind = \"file\"\npath = \"nope.csv\"\n"
                 "[[method]]\nkind = \"mccool\"\n",
                 {"cfg.toml:5: sampling.path: file not found"});
   }
   SECTION("contradiction: preset and model") {
-    require_one("[[brdf]]\npreset = \"bluepaint\"\nmodel = \"lafortune\"\n[[method]]\nkind = \"mccool\"\n",
+    require_one_config_error("[[brdf]]\npreset = \"bluepaint\"\nmodel = \"lafortune\"\n[[method]]\nkind = \"mccool\"\n",
                 {"cfg.toml:3: brdf[0].model: preset, model and file are alternatives"});
   }
   SECTION("contradiction: svd eps without log") {
-    require_one(std::string(kBase) + "[[method]]\nkind = \"svd\"\neps = 0.01\n",
+    require_one_config_error(std::string(kBase) + "[[method]]\nkind = \"svd\"\neps = 0.01\n",
                 {"cfg.toml:12: method[0].eps: eps applies only to the log-space SVD"});
   }
   SECTION("contradiction: a grid with a count") {
-    require_one("[[brdf]]\npreset = \"bluepaint\"\n[sampling]\nkind = \"grid\"\ncount = 100\n"
+    require_one_config_error("[[brdf]]\npreset = \"bluepaint\"\n[sampling]\nkind = \"grid\"\ncount = 100\n"
                 "[[method]]\nkind = \"mccool\"\n",
                 {"cfg.toml:5: sampling.count: does not apply to kind = \"grid\""});
   }
   SECTION("contradiction: measured samples of an analytic BRDF") {
-    require_one("[[brdf]]\npreset = \"bluepaint\"\n[sampling]\nkind = \"measured\"\n[[method]]\nkind = \"mccool\"\n",
+    require_one_config_error("[[brdf]]\npreset = \"bluepaint\"\n[sampling]\nkind = \"measured\"\n[[method]]\nkind = \"mccool\"\n",
                 {"cfg.toml:3: sampling.kind:", "not measured"});
   }
   SECTION("contradiction: sh-r order without view_order") {
-    require_one(std::string(kBase) + "[[method]]\nkind = \"sh-r\"\norder = 4\n",
+    require_one_config_error(std::string(kBase) + "[[method]]\nkind = \"sh-r\"\norder = 4\n",
                 {"cfg.toml:12: method[0].order: fixed orders need both order and view_order"});
   }
   SECTION("contradiction: fit terms beyond the projections") {
-    require_one(std::string(kBase) + "[[method]]\nkind = \"fit\"\nprojections = [{ name = \"wi\" }]\nterms = 2\n",
+    require_one_config_error(std::string(kBase) + "[[method]]\nkind = \"fit\"\nprojections = [{ name = \"wi\" }]\nterms = 2\n",
                 {"cfg.toml:13: method[0].terms: terms = 2 but only 1 projections"});
   }
   SECTION("contradiction: a named projection in the wrong parameterization") {
-    require_one(std::string(kBase) +
+    require_one_config_error(std::string(kBase) +
                     "[[method]]\nkind = \"fit\"\nprojections = [{ name = \"h\", parameterization = \"wiwo\" }]\n",
                 {"cfg.toml:12: method[0].projections[0].name:", "halfdiff projection"});
   }
   SECTION("a projection matrix that is not orthonormal") {
-    require_one(std::string(kBase) +
+    require_one_config_error(std::string(kBase) +
                     "[[method]]\nkind = \"fit\"\nprojections = [{ matrix = [[1, 1, 0, 0], [0, 0, 1, 0]] }]\n",
                 {"cfg.toml:12: method[0].projections[0].matrix:", "orthonormal"});
   }
   SECTION("refine on a kind that is not homomorphic") {
-    require_one(std::string(kBase) + "[[method]]\nkind = \"svd\"\nrefine = \"linear\"\n",
+    require_one_config_error(std::string(kBase) + "[[method]]\nkind = \"svd\"\nrefine = \"linear\"\n",
                 {"cfg.toml:12: method[0].refine:", "homomorphic kinds"});
   }
   SECTION("tolerance where the method does not support it") {
-    require_one(std::string(kBase) + "[[method]]\nkind = \"search\"\ntolerance = { metric = \"rel_mse\", value = 0.1 }\n",
+    require_one_config_error(std::string(kBase) + "[[method]]\nkind = \"search\"\ntolerance = { metric = \"rel_mse\", value = 0.1 }\n",
                 {"cfg.toml:12: method[0].tolerance: does not apply to kind = \"search\""});
   }
   SECTION("a bad tolerance metric") {
-    require_one(std::string(kBase) + "[[method]]\nkind = \"svd\"\ntolerance = { metric = \"rmse\", value = 0.1 }\n",
+    require_one_config_error(std::string(kBase) + "[[method]]\nkind = \"svd\"\ntolerance = { metric = \"rmse\", value = 0.1 }\n",
                 {"cfg.toml:12: method[0].tolerance.metric: expected one of"});
   }
   SECTION("search with nothing to start from") {
-    require_one(std::string(kBase) + "[[method]]\nkind = \"search\"\nrestarts = 0\n",
+    require_one_config_error(std::string(kBase) + "[[method]]\nkind = \"search\"\nrestarts = 0\n",
                 {"cfg.toml:12: method[0].restarts:", "nothing to search from"});
   }
   SECTION("unknown BRDF parameter, at its own line") {
-    require_one("[[brdf]]\nmodel = \"blinn-phong\"\nn = 10\nshininess = 3\n[[method]]\nkind = \"mccool\"\n",
+    require_one_config_error("[[brdf]]\nmodel = \"blinn-phong\"\nn = 10\nshininess = 3\n[[method]]\nkind = \"mccool\"\n",
                 {"cfg.toml:4: brdf[0].shininess:", "shininess"});
   }
   SECTION("unknown preset") {
-    require_one("[[brdf]]\npreset = \"bluepaynt\"\n[[method]]\nkind = \"mccool\"\n",
+    require_one_config_error("[[brdf]]\npreset = \"bluepaynt\"\n[[method]]\nkind = \"mccool\"\n",
                 {"cfg.toml:2: brdf[0].preset: unknown preset \"bluepaynt\"", "did you mean 'bluepaint'"});
   }
-  SECTION("no method") { require_one(kBase, {"cfg.toml: method: missing"}); }
+  SECTION("no method") { require_one_config_error(kBase, {"cfg.toml: method: missing"}); }
   SECTION("a method kind cannot be swept") {
-    require_one(std::string(kBase) + "[[method]]\nkind = [\"mccool\", \"svd\"]\n",
+    require_one_config_error(std::string(kBase) + "[[method]]\nkind = [\"mccool\", \"svd\"]\n",
                 {"cfg.toml:11: method[0].kind: cannot be a sweep"});
   }
   SECTION("an empty sweep") {
-    require_one(std::string(kBase) + "[[method]]\nkind = \"mccool\"\ntexture_size = []\n",
+    require_one_config_error(std::string(kBase) + "[[method]]\nkind = \"mccool\"\ntexture_size = []\n",
                 {"cfg.toml:12: method[0].texture_size:", "empty array"});
   }
 }
 
 TEST_CASE("config: every problem is reported, each once") {
-  const auto errs = errors_of(std::string(kBase) + R"(
+  const auto errs = config_errors(std::string(kBase) + R"(
 [[method]]
 kind = "search"
 terms = 0
@@ -234,7 +206,7 @@ zip = ["terms", "texture_size"]
   CHECK(p.methods[4].terms == 4);
   CHECK(p.methods[4].texture_size == 16);
   SECTION("unequal lengths are an error") {
-    require_one(std::string(kBase) + R"(
+    require_one_config_error(std::string(kBase) + R"(
 [[method]]
 kind = "svd"
 terms = [1, 2]
@@ -244,7 +216,7 @@ zip = ["terms", "texture_size"]
                 {"cfg.toml:15: method[0].zip: zipped lists must have equal lengths"});
   }
   SECTION("zip names a key that is not a sweep") {
-    require_one(std::string(kBase) + "[[method]]\nkind = \"svd\"\nterms = 2\ntexture_size = [8, 16]\n"
+    require_one_config_error(std::string(kBase) + "[[method]]\nkind = \"svd\"\nterms = 2\ntexture_size = [8, 16]\n"
                                      "zip = [\"terms\", \"texture_size\"]\n",
                 {"method[0].zip: 'terms' is not a sweep"});
   }
@@ -314,17 +286,17 @@ restarts = 6
     CHECK(p.methods[0].tolerance->value == 0.1);
   }
   SECTION("a bad overridden value is reported at the -D") {
-    require_one(text, {"-D sampling.resolution=1: sampling.resolution: expected an integer in 2..256, found 1"},
+    require_one_config_error(text, {"-D sampling.resolution=1: sampling.resolution: expected an integer in 2..256, found 1"},
                 {"sampling.resolution=1"});
   }
   SECTION("a key no method accepts") {
-    require_one(text, {"-D method.order=3: method.order: no [[method]] of this config accepts 'order'"},
+    require_one_config_error(text, {"-D method.order=3: method.order: no [[method]] of this config accepts 'order'"},
                 {"method.order=3"});
   }
   SECTION("malformed") {
-    require_one(text, {"-D nonsense: -D: expected key=value"}, {"nonsense"});
-    require_one(text, {"-D methd.x=1: methd.x: unknown section"}, {"methd.x=1"});
-    require_one(text, {"method[5].terms: index 5 out of range"}, {"method[5].terms=1"});
+    require_one_config_error(text, {"-D nonsense: -D: expected key=value"}, {"nonsense"});
+    require_one_config_error(text, {"-D methd.x=1: methd.x: unknown section"}, {"methd.x=1"});
+    require_one_config_error(text, {"method[5].terms: index 5 out of range"}, {"method[5].terms=1"});
   }
 }
 
@@ -394,6 +366,6 @@ TEST_CASE("config: non-greedy search keys (beam, backfit) are read, validated, a
   CHECK(p.methods[1].search.backfit_restarts == 1);
   CHECK(p.runs[0].run_id != g.runs[0].run_id);
   CHECK(p.runs[0].run_id != p.runs[1].run_id);
-  require_one(greedy + "beam = 4\n", {"cfg.toml:", "method[0]", "beam", "1..3", "found 4"});
-  require_one(greedy + "backfit_sweeps = -1\n", {"cfg.toml:", "method[0].backfit_sweeps", "found -1"});
+  require_one_config_error(greedy + "beam = 4\n", {"cfg.toml:", "method[0]", "beam", "1..3", "found 4"});
+  require_one_config_error(greedy + "backfit_sweeps = -1\n", {"cfg.toml:", "method[0].backfit_sweeps", "found -1"});
 }

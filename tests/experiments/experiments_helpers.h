@@ -122,4 +122,41 @@ terms = 1
 texture_size = 6
 )";
 
+// The head of the config-validation tests: one BRDF (bluepaint) on a 6^4 grid;
+// append [[method]] tables.
+inline const char* const kConfigHead = R"([experiment]
+name = "t"
+
+[[brdf]]
+preset = "bluepaint"
+
+[sampling]
+kind = "grid"
+resolution = 6
+)";
+
+// The messages of the ConfigError that parse_plan throws for `text` read as
+// "cfg.toml" (empty if it validates).
+inline std::vector<std::string> config_errors(const std::string& text,
+                                              const std::vector<std::string>& defines = {}) {
+  register_loaders();
+  try {
+    bf::parse_plan(text, "cfg.toml", defines);
+  } catch (const bf::ConfigError& e) {
+    return e.messages();
+  }
+  return {};
+}
+
+// Exactly one config error for `text`, containing every fragment.
+inline void require_one_config_error(const std::string& text, std::initializer_list<std::string> fragments,
+                                     const std::vector<std::string>& defines = {}) {
+  const auto errs = config_errors(text, defines);
+  std::string all;
+  for (const auto& m : errs) all += m + "\n";
+  INFO(all);
+  REQUIRE(errs.size() == 1);
+  for (const auto& f : fragments) CHECK(errs[0].find(f) != std::string::npos);
+}
+
 }  // namespace bf_test

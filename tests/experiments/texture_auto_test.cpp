@@ -10,42 +10,17 @@ using namespace bf;
 using namespace bf_test;
 
 namespace {
-const char* kHead = R"([experiment]
-name = "t"
-
-[[brdf]]
-preset = "bluepaint"
-
-[sampling]
-kind = "grid"
-resolution = 6
-
-[[method]]
-)";
-
-std::vector<std::string> errors_for(const std::string& method) {
-  register_loaders();
-  try {
-    parse_plan(std::string(kHead) + method, "cfg.toml");
-  } catch (const ConfigError& e) {
-    return e.messages();
-  }
-  return {};
-}
+// One [[method]] table after the common head.
+std::string with_method(const std::string& method) { return std::string(kConfigHead) + "\n[[method]]\n" + method; }
 
 void require_error(const std::string& method, std::initializer_list<std::string> fragments) {
-  const auto errs = errors_for(method);
-  std::string all;
-  for (const auto& m : errs) all += m + "\n";
-  INFO(all);
-  REQUIRE(errs.size() == 1);
-  for (const auto& f : fragments) CHECK(errs[0].find(f) != std::string::npos);
+  require_one_config_error(with_method(method), fragments);
 }
 }  // namespace
 
 TEST_CASE("config: texture_size = \"auto\" fills the ladder (svd, mccool, fit)") {
   register_loaders();
-  const Plan p = parse_plan(std::string(kHead) + R"(kind = "svd"
+  const Plan p = parse_plan(with_method(R"(kind = "svd"
 texture_size = "auto"
 terms = 6
 tolerance = { metric = "rel_mse", value = 0.05 }
@@ -59,7 +34,7 @@ tolerance = { metric = "cos_rmse", value = 0.1 }
 [[method]]
 kind = "svd"
 texture_size = 12
-)", "cfg.toml");
+)"), "cfg.toml");
   REQUIRE(p.methods.size() == 3);
   const MethodVariant& svd = p.methods[0];
   CHECK(svd.texture_ladder == std::vector<int>{8, 12, 16, 24, 32});
