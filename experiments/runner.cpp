@@ -33,6 +33,7 @@
 #include "brdfs/measured.h"
 #define BF_HAVE_MEASURED 1
 #endif
+#include "brdfs/merl.h"
 
 namespace bf {
 
@@ -151,6 +152,21 @@ std::shared_ptr<const SampleSet> make_samples(const Plan& plan, const PlannedRun
 }
 
 // ------------------------------------------------------------------ one run
+
+// How a tabulating method (svd, sh-k, sh-r) reads `brdf` when it is measured
+// data: the interpolation between measurements; "" for analytic BRDFs.
+std::string resampling_note(const Brdf& brdf) {
+#ifdef BF_HAVE_MEASURED
+  if (const auto* mb = dynamic_cast<const MeasuredBrdf*>(&brdf))
+    return "resampled: tabulated from the modified Shepard interpolant (k = " +
+           std::to_string(mb->options().neighbours) + ", Marschner space) of " +
+           std::to_string(mb->samples().size()) + " measured samples";
+#endif
+  if (const auto* mb = dynamic_cast<const MerlBrdf*>(&brdf))
+    return std::string("resampled: tabulated from the MERL table by ") +
+           (mb->lookup() == MerlLookup::Linear ? "trilinear interpolation of bin centres" : "nearest bin");
+  return "";
+}
 
 std::string describe_method(const MethodVariant& m) {
   static const std::map<std::string, std::vector<std::string>> shown = {
@@ -428,6 +444,11 @@ RunEntry execute_run(const Plan& plan, const PlannedRun& pr, const SampleSet& sa
     row["view_order"] = std::to_string(shr->view_order());
   } else if (auto mf = std::dynamic_pointer_cast<const ModelFitFactorization>(f)) {
     row["model"] = mf->result().spec;
+  }
+  // Tabulating methods read a measured BRDF at their own grid nodes, i.e. off
+  // its interpolant, not at the measured directions: say which one.
+  if (m.kind == "svd" || m.kind == "sh-k" || m.kind == "sh-r") {
+    if (const std::string how = resampling_note(*b.brdf); !how.empty()) notes.push_back(how);
   }
   row["samples"] = std::to_string(mt.samples);
   const std::pair<const char*, double> metric_cells[] = {

@@ -368,3 +368,35 @@ TEST_CASE("runner: the Slurm template's tasks merge into the whole experiment") 
   INFO(text);
   CHECK(read_results_csv(tmp / "merged/results.csv").size() == 5);
 }
+
+TEST_CASE("runner: tabulating methods on measured data say how it was resampled") {
+  ScratchDir tmp;
+  const std::string cfg = write_text(tmp / "measured.toml", R"(
+[[brdf]]
+model = "krylon-blue"
+[[brdf]]
+preset = "bluepaint"
+[sampling]
+kind = "stratified"
+count = 600
+[[method]]
+kind = "svd"
+texture_size = 4
+terms = 1
+[[method]]
+kind = "mccool"
+texture_size = 4
+)");
+  const std::string out = tmp / "out";
+  run_quiet(cfg, out);
+  const auto rows = read_results_csv(out + "/results.csv");
+  REQUIRE(rows.size() == 4);
+  for (const auto& r : rows) {
+    INFO(r.at("brdf") << " " << r.at("method") << ": " << r.at("notes"));
+    const bool resampled = r.at("notes").find("resampled: tabulated from the modified Shepard interpolant") !=
+                           std::string::npos;
+    // Only the SVD of the measured paint reads an interpolant; McCool fits the
+    // samples themselves and bluepaint is analytic.
+    CHECK(resampled == (r.at("brdf") == "krylon-blue" && r.at("method") == "svd"));
+  }
+}
