@@ -153,6 +153,7 @@ std::shared_ptr<const SampleSet> make_samples(const Plan& plan, const PlannedRun
 
 // ------------------------------------------------------------------ one run
 
+
 // How a tabulating method (svd, sh-k, sh-r) reads `brdf` when it is measured
 // data: the interpolation between measurements; "" for analytic BRDFs.
 std::string resampling_note(const Brdf& brdf) {
@@ -249,7 +250,7 @@ void set_presentation(Row& row, const Plan& plan, const PlannedRun& r) {
 }
 
 RunEntry execute_run(const Plan& plan, const PlannedRun& pr, const SampleSet& samples, const fs::path& exp_dir,
-                     RenderCache& renders) {
+                     RenderCache& renders, const json& build) {
   const BrdfVariant& b = plan.brdfs[pr.brdf];
   const SamplingVariant& s = plan.samplings[pr.sampling];
   const MethodVariant& m = plan.methods[pr.method];
@@ -522,6 +523,7 @@ RunEntry execute_run(const Plan& plan, const PlannedRun& pr, const SampleSet& sa
   row["notes"] = join(notes, "; ");
   rec["notes"] = notes;
   rec["wall_seconds"] = since(wall0);
+  rec["build"] = build;
   std::vector<std::string> files = list_files(exp_dir, run_dir);
   files.push_back(fs::relative(run_dir / "run.json", exp_dir).generic_string());
   std::sort(files.begin(), files.end());
@@ -617,6 +619,22 @@ void parse_shard(const std::string& text, int& k, int& n) {
   if (n < 1 || k < 1 || k > n) throw bad();
 }
 
+json build_identity(const json& versions) {
+  json b = {{"brdf_factor", versions.value("brdf_factor", "")}};
+  if (versions.contains("git_commit")) {
+    b["git_commit"] = versions["git_commit"];
+    b["git_dirty"] = versions.value("git_dirty", false);
+  }
+  return b;
+}
+
+std::string cached_run_commit(const json& record) {
+  const auto it = record.find("build");
+  if (it == record.end() || !it->is_object()) return "";
+  const auto c = it->find("git_commit");
+  return c != it->end() && c->is_string() ? c->get<std::string>() : "";
+}
+
 RunSummary run_experiment(const RunOptions& opt, std::ostream& out, std::ostream& err) {
   if (opt.shards < 1 || opt.shard < 1 || opt.shard > opt.shards)
     throw std::invalid_argument("--shard: expected K/N with 1 <= K <= N, found " + std::to_string(opt.shard) + "/" +
@@ -652,6 +670,25 @@ RunSummary run_experiment(const RunOptions& opt, std::ostream& out, std::ostream
     else if (a == Action::OtherShard) ++n_other;
     else ++n_run;
   }
+
+  // The cache key is the config, not the code: say when reused runs come from
+  // another build (git commit of the source tree), so results that a fitter
+  // change would alter are not mixed in silently.
+  const json build = build_identity(software_versions());
+  std::set<std::string> other_commits;
+  for (size_t i = 0; i < plan.runs.size(); ++i) {
+    if (action[i] != Action::Cached) continue;
+    const std::string theirs = cached_run_commit(cached[i]->record);
+    if (build.contains("git_commit") && theirs != build["git_commit"].get<std::string>()) {
+      ++sum.cached_other_build;
+      other_commits.insert(theirs.empty() ? "unrecorded" : theirs);
+    }
+  }
+  if (sum.cached_other_build)
+    err << "brdf-factor: warning: " << sum.cached_other_build << " of " << n_cached
+        << " cached runs were made by another build (" << join(std::vector<std::string>(other_commits.begin(), other_commits.end()), ", ")
+        << "; this build " << build["git_commit"].get<std::string>()
+        << "): the cache does not see code changes, --force redoes them\n";
 
   if (opt.dry_run) {
     out << "experiment " << plan.experiment.name << ": " << plan.runs.size() << " runs (" << plan.brdfs.size()
@@ -745,7 +782,7 @@ RunSummary run_experiment(const RunOptions& opt, std::ostream& out, std::ostream
       const auto t0 = Clock::now();
       RunEntry e;
       try {
-        e = execute_run(plan, r, *samples.at(r.samples_key), exp_dir, renders);
+        e = execute_run(plan, r, *samples.at(r.samples_key), exp_dir, renders, build);
       } catch (const std::exception& ex) {
         std::error_code ec;
         fs::remove_all(exp_dir / "runs" / r.run_id, ec);

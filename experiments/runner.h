@@ -41,9 +41,17 @@ struct RunSummary {
   size_t cached = 0;       // reused from runs/<id>/
   size_t redone = 0;       // incomplete folders (no DONE) computed again
   size_t failed = 0;
+  size_t cached_other_build = 0;  // cached runs made by another git commit (or none recorded), warned about
   std::vector<std::string> run_ids;  // this shard's runs, plan order
   OutputFiles files;       // empty for a dry run
 };
+
+// What each run.json records of the build that made it (key "build"):
+// brdf_factor version, and git_commit / git_dirty of the source tree when it
+// is a git checkout (software_versions()).
+nlohmann::json build_identity(const nlohmann::json& versions);
+// A run record's build.git_commit; "" when it has none (older runs, no git).
+std::string cached_run_commit(const nlohmann::json& record);
 
 // Parses "K/N" with 1 <= K <= N; throws std::invalid_argument naming --shard.
 void parse_shard(const std::string& text, int& k, int& n);

@@ -400,3 +400,54 @@ texture_size = 4
     CHECK(resampled == (r.at("brdf") == "krylon-blue" && r.at("method") == "svd"));
   }
 }
+
+TEST_CASE("runner: cached runs made by another build are counted and warned about") {
+  ScratchDir tmp;
+  const std::string cfg = write_text(tmp / "two.toml", R"(
+[[brdf]]
+preset = "bluepaint"
+[sampling]
+resolution = 5
+[[method]]
+kind = "mccool"
+texture_size = [4, 5]
+)");
+  const std::string out = tmp / "out";
+  const RunSummary first = run_quiet(cfg, out);
+  REQUIRE(first.executed == 2);
+  const nlohmann::json build = build_identity(software_versions());
+  CHECK(build.contains("brdf_factor"));
+  if (!build.contains("git_commit")) {
+    WARN("the source tree is not a git checkout: nothing to compare builds by");
+    return;
+  }
+  // Every run records the build that made it.
+  const std::string run_json = out + "/runs/" + first.run_ids[0] + "/run.json";
+  nlohmann::json rec = nlohmann::json::parse(read_text(run_json));
+  CHECK(cached_run_commit(rec) == build["git_commit"].get<std::string>());
+  // Same build: reused silently.
+  RunOptions o;
+  o.config = cfg;
+  o.out = out;
+  o.quiet = true;
+  std::ostringstream sout, serr;
+  RunSummary again = run_experiment(o, sout, serr);
+  CHECK(again.cached == 2);
+  CHECK(again.cached_other_build == 0);
+  CHECK(serr.str().find("another build") == std::string::npos);
+  // One run from another commit, one with no record at all (an older version).
+  rec["build"]["git_commit"] = "0123456789ab";
+  write_text(run_json, rec.dump(2));
+  const std::string run_json2 = out + "/runs/" + first.run_ids[1] + "/run.json";
+  nlohmann::json rec2 = nlohmann::json::parse(read_text(run_json2));
+  rec2.erase("build");
+  write_text(run_json2, rec2.dump(2));
+  std::ostringstream sout2, serr2;
+  again = run_experiment(o, sout2, serr2);
+  CHECK(again.cached == 2);
+  CHECK(again.cached_other_build == 2);
+  INFO(serr2.str());
+  CHECK(serr2.str().find("warning: 2 of 2 cached runs were made by another build (0123456789ab, unrecorded; "
+                         "this build " + build["git_commit"].get<std::string>()) != std::string::npos);
+  CHECK(serr2.str().find("--force redoes them") != std::string::npos);
+}
