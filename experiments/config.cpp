@@ -116,7 +116,7 @@ const std::map<std::string, std::vector<std::string>>& key_table() {
                   {"parameterization", "terms", "search_texture_size", "restarts", "guesses",
                    "reciprocity", "optimizer", "ftol", "line_tol", "initial_step", "max_sweeps",
                    "max_evaluations", "threads", "seed", "beam", "backfit_sweeps",
-                   "backfit_restarts"}})},
+                   "backfit_restarts", "tolerance"}})},
       {"method:svd", join_keys({kCommonMethodKeys,
                                 {"texture_size", "terms", "parameterization", "log", "eps",
                                  "subtract_eps", "rim_inset", "extend_below_horizon",
@@ -1410,7 +1410,11 @@ void read_method(Reader& r, Ctx& ctx, const std::string& kind, uint64_t base_see
   } else if (kind == "search") {
     SearchOptions& s = m.search;
     m.param = read_param(r, "parameterization", s.param);
-    m.terms = static_cast<int>(r.integer("terms", s.terms, 1, 64));
+    m.tolerance = read_tolerance(r, ctx);
+    // With a tolerance, `terms` is the cap (default 8): the greedy search stops
+    // at the first term whose refit reaches the target.
+    m.terms = static_cast<int>(r.integer("terms", m.tolerance ? 8 : s.terms, 1, 64));
+    if (m.tolerance) m.cap = m.terms;
     m.texture_size = static_cast<int>(r.integer("texture_size", s.texture_size, 2, 1024));
     s.search_texture_size = static_cast<int>(r.integer("search_texture_size", 0, 0, 1024));
     if (s.search_texture_size == 1) r.fail("search_texture_size", "expected 0 (same as texture_size) or 2..1024, found 1");
@@ -1473,6 +1477,12 @@ void read_method(Reader& r, Ctx& ctx, const std::string& kind, uint64_t base_see
     if (s.beam != 1) o["beam"] = s.beam;
     if (s.backfit_sweeps != 0) o["backfit_sweeps"] = s.backfit_sweeps;
     if (s.backfit_sweeps != 0 && s.backfit_restarts != 0) o["backfit_restarts"] = s.backfit_restarts;
+    if (m.tolerance) {
+      o["tolerance"] = {{"metric", m.tolerance->metric}, {"value", m.tolerance->value}};
+      if (s.beam != 1)
+        r.fail("tolerance", "a tolerance stops the greedy search after a term, which needs beam = 1; found beam = " +
+                                std::to_string(s.beam));
+    }
     m.execution["threads"] = s.threads;
     const int starts = s.restarts + static_cast<int>(s.guesses.size());
     m.cores = std::max(1, std::min(s.threads == 0 ? hardware_cores() : s.threads, starts));

@@ -315,7 +315,30 @@ RunEntry execute_run(const Plan& plan, const PlannedRun& pr, const SampleSet& sa
     }
   } else if (m.kind == "search") {
     const FitData data(samples, m.fit.eps);
-    SearchResult sr = search_factorization(data, m.search);
+    SearchOptions so = m.search;
+    SizeChoice c;  // with a tolerance: the terms tried, filled as the search goes
+    if (m.tolerance) {
+      // The greedy search stops at the first term whose refit reaches the
+      // target (search/term_search.h, stop_after_term); later terms are never searched.
+      c.method = "search";
+      c.knob = "terms";
+      c.metric = m.tolerance->metric;
+      so.stop_after_term = [&](const HomomorphicFactorization& hf) {
+        const double v = metric_value(evaluate_metrics(hf, samples, lt), c.metric);
+        c.tried.push_back({static_cast<int>(hf.terms().size()), -1, v});
+        c.value = static_cast<int>(hf.terms().size());
+        c.error = v;
+        c.reached = v <= m.tolerance->value;
+        return c.reached;
+      };
+    }
+    SearchResult sr = search_factorization(data, so);
+    if (m.tolerance) {
+      c.seconds = sr.seconds;
+      c.result = sr.factorization;
+      c.errors_after_term = sr.rel_mse_after_term;
+      choice = c;
+    }
     h = sr.factorization;
     errs = sr.rel_mse_after_term;
     evaluations = sr.evaluations;

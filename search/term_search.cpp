@@ -50,6 +50,9 @@ void SearchOptions::validate() const {
   if (backfit_restarts < 0)
     throw std::invalid_argument("backfit_restarts: expected >= 0, found " +
                                 std::to_string(backfit_restarts));
+  if (stop_after_term && beam != 1)
+    throw std::invalid_argument("beam: a stopping rule (tolerance) ends the greedy search after a term, "
+                                "which needs beam = 1; found beam = " + std::to_string(beam));
   fit.validate();
   powell.validate();
 }
@@ -370,8 +373,19 @@ SearchResult search_factorization(const FitData& data, const SearchOptions& opt)
     // The first term's search cost is shared by the branches: booked on branch 0.
     add_term(data, opt, sres, b, first[order[k]], static_cast<int>(order[k]),
              k == 0 ? first_evals : 0, t1);
-    for (int j = 1; j < opt.terms; ++j) {
+    // With a stopping rule every added term is backfitted at once (the order of
+    // operations is the same as without: add, backfit, search the next term).
+    const auto stop_here = [&] {
+      if (!opt.stop_after_term) return false;
       backfit(data, opt, sres, b);
+      std::vector<TermSpec> specs;
+      for (const Rotation4& R : b.rotations)
+        specs.push_back(TermSpec{R.projection(opt.param, opt.texture_size), opt.reciprocity, R.packed()});
+      return opt.stop_after_term(*fit_homomorphic(data, specs, opt.fit, "search"));
+    };
+    bool stopped = stop_here();
+    for (int j = 1; j < opt.terms && !stopped; ++j) {
+      if (!opt.stop_after_term) backfit(data, opt, sres, b);
       const double tj = now_seconds();
       const std::vector<StartResult> res = search_term(data, opt, sres, b);
       size_t best = 0;
@@ -381,8 +395,9 @@ SearchResult search_factorization(const FitData& data, const SearchOptions& opt)
         if (res[i].value < res[best].value) best = i;
       }
       add_term(data, opt, sres, b, res[best], static_cast<int>(best), evals, tj);
+      stopped = stop_here();
     }
-    backfit(data, opt, sres, b);
+    if (!opt.stop_after_term) backfit(data, opt, sres, b);
     out.evaluations += b.evaluations - (k == 0 ? first_evals : 0);
 
     // Refit the found projections at the final resolution (thesis 4.2).

@@ -19,6 +19,7 @@
 //    objective.
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -46,6 +47,11 @@ struct SearchOptions {
   int beam = 1;                         // first-term candidates continued; 1 = greedy
   int backfit_sweeps = 0;               // cyclic re-search sweeps after each added term
   int backfit_restarts = 0;             // random starts per re-search besides the current rotation
+  // Optional stopping rule (a tolerance), greedy search (beam = 1) only: after
+  // each added term (and its backfitting), the projections found so far are
+  // refit at texture_size and passed here; true ends the search with those
+  // terms, so later terms are never searched. Empty: all `terms` are built.
+  std::function<bool(const HomomorphicFactorization&)> stop_after_term;
   void validate() const;                // throws naming the field, value and rule
 };
 

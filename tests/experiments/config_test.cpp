@@ -123,8 +123,9 @@ TEST_CASE("config: each rule broken gives one message with file:line, field and 
                 {"cfg.toml:12: method[0].refine:", "homomorphic kinds"});
   }
   SECTION("tolerance where the method does not support it") {
-    require_one_config_error(std::string(kBase) + "[[method]]\nkind = \"search\"\ntolerance = { metric = \"rel_mse\", value = 0.1 }\n",
-                {"cfg.toml:12: method[0].tolerance: does not apply to kind = \"search\""});
+    require_one_config_error(std::string(kBase) + "[[method]]\nkind = \"model-fit\"\nmodel = \"ward\"\n"
+                             "tolerance = { metric = \"rel_mse\", value = 0.1 }\n",
+                {"cfg.toml:13: method[0].tolerance: does not apply to kind = \"model-fit\""});
   }
   SECTION("a bad tolerance metric") {
     require_one_config_error(std::string(kBase) + "[[method]]\nkind = \"svd\"\ntolerance = { metric = \"rmse\", value = 0.1 }\n",

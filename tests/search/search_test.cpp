@@ -206,3 +206,48 @@ TEST_CASE("search: the backfitting objective with one term changed equals a fres
   bad.backfit_sweeps = -1;
   CHECK_THROWS_WITH(bad.validate(), Catch::Contains("backfit_sweeps") && Catch::Contains("-1"));
 }
+
+TEST_CASE("search: a stopping rule ends the greedy search after the term it accepts") {
+  const bf_test::PlantedBrdf brdf;
+  const SampleSet s = sample_grid(brdf, 8);
+  SearchOptions opt;
+  opt.terms = 3;
+  opt.texture_size = 6;
+  opt.restarts = 2;
+  opt.powell.ftol = 1e-2;
+  opt.threads = 1;
+  const FitData d(s, opt.fit.eps);
+  const SearchResult all = search_factorization(d, opt);
+  REQUIRE(all.rel_mse_after_term.size() == 3);
+
+  SECTION("stopping at term 2 gives the 2-term search, term 3 is never searched") {
+    std::vector<double> seen;  // rel_mse of each refit handed to the rule
+    opt.stop_after_term = [&](const HomomorphicFactorization& h) {
+      seen.push_back(evaluate_metrics(h, s, LogTransform::of(s, opt.fit.eps)).rel_mse);
+      return h.terms().size() == 2;
+    };
+    const SearchResult two = search_factorization(d, opt);
+    REQUIRE(seen.size() == 2);
+    REQUIRE(two.rel_mse_after_term.size() == 2);
+    CHECK(two.terms.size() == 2);
+    // Same operations in the same order as the full search up to term 2.
+    CHECK(two.terms[1].rotation == all.terms[1].rotation);
+    CHECK(two.rel_mse_after_term[1] == Approx(all.rel_mse_after_term[1]).epsilon(1e-12));
+    CHECK(two.evaluations < all.evaluations);
+    // The rule saw the refit at texture_size after each term (the metrics score
+    // the stored float texels, the fit its double sums: equal to float rounding).
+    CHECK(seen[1] == Approx(two.rel_mse_after_term[1]).epsilon(1e-6));
+  }
+  SECTION("a rule that never accepts builds every term, the same as no rule") {
+    int calls = 0;
+    opt.stop_after_term = [&](const HomomorphicFactorization&) { return ++calls < 0; };
+    const SearchResult r = search_factorization(d, opt);
+    CHECK(calls == 3);
+    CHECK(r.rel_mse_after_term == all.rel_mse_after_term);
+  }
+  SECTION("a rule with beam > 1 is refused naming beam") {
+    opt.beam = 2;
+    opt.stop_after_term = [](const HomomorphicFactorization&) { return true; };
+    CHECK_THROWS_WITH(opt.validate(), Catch::Contains("beam") && Catch::Contains("stopping rule"));
+  }
+}
