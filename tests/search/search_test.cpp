@@ -27,6 +27,21 @@ class OneTermBrdf final : public Brdf {
  private:
   Mat24 P_;
 };
+
+// The small searches the determinism, beam and stopping tests share: the
+// planted BRDF of fit_helpers.h on an 8^4 grid, texture 6, a loose Powell stop.
+const SampleSet& planted_grid8() {
+  static const SampleSet s = sample_grid(bf_test::PlantedBrdf(), 8);
+  return s;
+}
+SearchOptions small_search(int terms, int restarts) {
+  SearchOptions opt;
+  opt.terms = terms;
+  opt.texture_size = 6;
+  opt.restarts = restarts;
+  opt.powell.ftol = 1e-2;
+  return opt;
+}
 }  // namespace
 
 TEST_CASE("powell: finds the minimum of a smooth function of the rotation") {
@@ -71,13 +86,8 @@ TEST_CASE("search: recovers a planted single-term projection") {
 }
 
 TEST_CASE("search: deterministic for a seed, whatever the thread count") {
-  const bf_test::PlantedBrdf brdf;
-  const SampleSet s = sample_grid(brdf, 8);
-  SearchOptions opt;
-  opt.terms = 2;
-  opt.texture_size = 6;
-  opt.restarts = 3;
-  opt.powell.ftol = 1e-2;
+  const SampleSet& s = planted_grid8();
+  SearchOptions opt = small_search(2, 3);
   const FitData d(s, opt.fit.eps);
   opt.threads = 1;
   const SearchResult a = search_factorization(d, opt);
@@ -123,13 +133,8 @@ TEST_CASE("search: options are validated with the field named") {
 }
 
 TEST_CASE("search: beam and backfitting are never worse than greedy, and deterministic") {
-  const bf_test::PlantedBrdf brdf;
-  const SampleSet s = sample_grid(brdf, 8);
-  SearchOptions opt;
-  opt.terms = 2;
-  opt.texture_size = 6;
-  opt.restarts = 3;
-  opt.powell.ftol = 1e-2;
+  const SampleSet& s = planted_grid8();
+  SearchOptions opt = small_search(2, 3);
   const FitData d(s, opt.fit.eps);
   const SearchResult greedy = search_factorization(d, opt);
   REQUIRE(greedy.beam_rel_mse.size() == 1);
@@ -208,13 +213,8 @@ TEST_CASE("search: the backfitting objective with one term changed equals a fres
 }
 
 TEST_CASE("search: a stopping rule ends the greedy search after the term it accepts") {
-  const bf_test::PlantedBrdf brdf;
-  const SampleSet s = sample_grid(brdf, 8);
-  SearchOptions opt;
-  opt.terms = 3;
-  opt.texture_size = 6;
-  opt.restarts = 2;
-  opt.powell.ftol = 1e-2;
+  const SampleSet& s = planted_grid8();
+  SearchOptions opt = small_search(3, 2);
   opt.threads = 1;
   const FitData d(s, opt.fit.eps);
   const SearchResult all = search_factorization(d, opt);
