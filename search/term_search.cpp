@@ -7,6 +7,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <mutex>
 #include <stdexcept>
@@ -126,6 +127,18 @@ StartResult nlopt_minimize(const RotationObjective& f, const Rotation4& start,
       &ctx);
   std::vector<double> a(6, 0.0);
   double fv = std::numeric_limits<double>::infinity();
+  // PRAXIS and CRS draw from nlopt's own generator, which is seeded from the
+  // clock unless told otherwise (two runs gave 643 and 743 fits). Seed it from
+  // the start rotation, itself a function of (seed, term, restart), in the
+  // thread that optimizes (nlopt's generator state is per thread), so a search
+  // is the same run to run and whatever thread takes the start.
+  uint64_t h = 0xcbf29ce484222325ull ^ opt.seed;
+  for (double v : start.packed()) {
+    uint64_t bits = 0;
+    std::memcpy(&bits, &v, sizeof bits);
+    h = (h ^ bits) * 0x100000001b3ull;
+  }
+  nlopt::srand(static_cast<unsigned long>(h));
   try {
     o.optimize(a, fv);
   } catch (const nlopt::roundoff_limited&) {

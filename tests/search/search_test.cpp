@@ -251,3 +251,23 @@ TEST_CASE("search: a stopping rule ends the greedy search after the term it acce
     CHECK_THROWS_WITH(opt.validate(), Catch::Contains("beam") && Catch::Contains("stopping rule"));
   }
 }
+
+TEST_CASE("search: nlopt's randomized optimizers (praxis, crs) are deterministic for a seed") {
+  const SampleSet& s = planted_grid8();
+  for (const char* optimizer : {"praxis", "crs"}) {
+    INFO(optimizer);
+    SearchOptions opt = small_search(1, 2);
+    opt.optimizer = optimizer;
+    opt.powell.max_evaluations = 300;
+    const FitData d(s, opt.fit.eps);
+    opt.threads = 1;
+    const SearchResult a = search_factorization(d, opt);
+    const SearchResult b = search_factorization(d, opt);
+    opt.threads = 2;
+    const SearchResult c = search_factorization(d, opt);
+    CHECK(a.evaluations == b.evaluations);
+    CHECK(a.rel_mse_after_term == b.rel_mse_after_term);
+    CHECK(a.evaluations == c.evaluations);
+    CHECK(a.terms[0].rotation == c.terms[0].rotation);
+  }
+}
