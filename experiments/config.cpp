@@ -1223,7 +1223,8 @@ int read_texture_size(Reader& r, MethodVariant& m, json& o, int def, int lo, int
   return size;
 }
 
-std::optional<Tolerance> read_tolerance(Reader& r, Ctx& ctx) {
+// The method's `tolerance` table, also recorded in its options `o` (so the run id).
+std::optional<Tolerance> read_tolerance(Reader& r, Ctx& ctx, json& o) {
   const toml::node* n = r.take("tolerance");
   if (!n) return std::nullopt;
   auto t = n->as_table();
@@ -1243,6 +1244,7 @@ std::optional<Tolerance> read_tolerance(Reader& r, Ctx& ctx) {
     r.mark_failed();
     return std::nullopt;
   }
+  o["tolerance"] = {{"metric", tol.metric}, {"value", tol.value}};
   return tol;
 }
 
@@ -1376,8 +1378,7 @@ void read_method(Reader& r, Ctx& ctx, const std::string& kind, uint64_t base_see
 
   if (kind == "mccool") {
     m.texture_size = read_texture_size(r, m, o, 16, 2, 1024);
-    m.tolerance = read_tolerance(r, ctx);
-    if (m.tolerance) o["tolerance"] = {{"metric", m.tolerance->metric}, {"value", m.tolerance->value}};
+    m.tolerance = read_tolerance(r, ctx, o);
     if (m.tolerance && m.texture_ladder.empty())
       r.fail("tolerance", "kind = \"mccool\" has exactly 2 textures: a tolerance can only choose the resolution "
                           "(set texture_size = \"auto\")");
@@ -1393,7 +1394,7 @@ void read_method(Reader& r, Ctx& ctx, const std::string& kind, uint64_t base_see
     m.param = read_param(r, "parameterization", Parameterization::WiWo);
     m.reciprocity = r.boolean("reciprocity", false);
     read_fit_options(r, m.fit, o);
-    m.tolerance = read_tolerance(r, ctx);
+    m.tolerance = read_tolerance(r, ctx, o);
     o["parameterization"] = to_string(m.param);
     o["reciprocity"] = m.reciprocity;
     read_projections(r, ctx, m, o);
@@ -1404,13 +1405,10 @@ void read_method(Reader& r, Ctx& ctx, const std::string& kind, uint64_t base_see
                           " projections are given (terms uses the first `terms` of them)");
     o["terms"] = m.terms;
     cap_terms(n);
-    if (m.tolerance) o["tolerance"] = {{"metric", m.tolerance->metric}, {"value", m.tolerance->value}};
-    if (!m.texture_ladder.empty() && !m.tolerance)
-      r.fail("texture_size", "texture_size = \"auto\" needs a tolerance (the error target that picks the size)");
   } else if (kind == "search") {
     SearchOptions& s = m.search;
     m.param = read_param(r, "parameterization", s.param);
-    m.tolerance = read_tolerance(r, ctx);
+    m.tolerance = read_tolerance(r, ctx, o);
     // With a tolerance, `terms` is the cap (default 8): the greedy search stops
     // at the first term whose refit reaches the target.
     m.terms = static_cast<int>(r.integer("terms", m.tolerance ? 8 : s.terms, 1, 64));
@@ -1477,12 +1475,9 @@ void read_method(Reader& r, Ctx& ctx, const std::string& kind, uint64_t base_see
     if (s.beam != 1) o["beam"] = s.beam;
     if (s.backfit_sweeps != 0) o["backfit_sweeps"] = s.backfit_sweeps;
     if (s.backfit_sweeps != 0 && s.backfit_restarts != 0) o["backfit_restarts"] = s.backfit_restarts;
-    if (m.tolerance) {
-      o["tolerance"] = {{"metric", m.tolerance->metric}, {"value", m.tolerance->value}};
-      if (s.beam != 1)
-        r.fail("tolerance", "a tolerance stops the greedy search after a term, which needs beam = 1; found beam = " +
-                                std::to_string(s.beam));
-    }
+    if (m.tolerance && s.beam != 1)
+      r.fail("tolerance", "a tolerance stops the greedy search after a term, which needs beam = 1; found beam = " +
+                              std::to_string(s.beam));
     m.execution["threads"] = s.threads;
     const int starts = s.restarts + static_cast<int>(s.guesses.size());
     m.cores = std::max(1, std::min(s.threads == 0 ? hardware_cores() : s.threads, starts));
@@ -1496,7 +1491,7 @@ void read_method(Reader& r, Ctx& ctx, const std::string& kind, uint64_t base_see
   } else if (kind == "svd") {
     SvdOptions& v = m.svd;
     m.texture_size = read_texture_size(r, m, o, v.res, 2, 256);
-    m.tolerance = read_tolerance(r, ctx);
+    m.tolerance = read_tolerance(r, ctx, o);
     m.terms = static_cast<int>(r.integer("terms", m.tolerance ? 16 : v.rank, 1, 100000));
     m.param = read_param(r, "parameterization", v.param);
     v.log = r.boolean("log", v.log);
@@ -1522,12 +1517,7 @@ void read_method(Reader& r, Ctx& ctx, const std::string& kind, uint64_t base_see
     o["rim_inset"] = v.rim_inset;
     o["extend_below_horizon"] = v.extend_below_horizon;
     o["float_textures"] = v.float_textures;
-    if (m.tolerance) {
-      m.cap = m.terms;
-      o["tolerance"] = {{"metric", m.tolerance->metric}, {"value", m.tolerance->value}};
-    } else if (!m.texture_ladder.empty()) {
-      r.fail("texture_size", "texture_size = \"auto\" needs a tolerance (the error target that picks the size)");
-    }
+    if (m.tolerance) m.cap = m.terms;
     m.cores = hardware_cores();
     if (!r.failed()) {
       try {
@@ -1538,7 +1528,7 @@ void read_method(Reader& r, Ctx& ctx, const std::string& kind, uint64_t base_see
     }
   } else if (kind == "sh-k") {
     ShkOptions& k = m.shk;
-    m.tolerance = read_tolerance(r, ctx);
+    m.tolerance = read_tolerance(r, ctx, o);
     k.order = static_cast<int>(r.integer("order", m.tolerance ? 30 : k.order, 0, 200));
     m.texture_size = static_cast<int>(r.integer("texture_size", k.view_res, 2, 512));
     k.view_res = m.texture_size;
@@ -1556,10 +1546,7 @@ void read_method(Reader& r, Ctx& ctx, const std::string& kind, uint64_t base_see
     o["rim_inset"] = k.rim_inset;
     o["min_cos"] = k.min_cos;
     o["float_textures"] = k.float_textures;
-    if (m.tolerance) {
-      m.cap = k.order;
-      o["tolerance"] = {{"metric", m.tolerance->metric}, {"value", m.tolerance->value}};
-    }
+    if (m.tolerance) m.cap = k.order;
     m.cores = hardware_cores();
     if (!r.failed()) {
       try {
@@ -1608,7 +1595,7 @@ void read_method(Reader& r, Ctx& ctx, const std::string& kind, uint64_t base_see
     }
   } else if (kind == "sh-r") {
     ShrOptions& s = m.shr;
-    m.tolerance = read_tolerance(r, ctx);
+    m.tolerance = read_tolerance(r, ctx, o);
     const bool has_order = r.has("order"), has_view = r.has("view_order");
     s.max_order = static_cast<int>(r.integer("max_order", s.max_order, 0, 400));
     s.max_view_order = static_cast<int>(r.integer("max_view_order", s.max_view_order, 0, 100));
@@ -1642,10 +1629,7 @@ void read_method(Reader& r, Ctx& ctx, const std::string& kind, uint64_t base_see
     o["theta_o_nodes"] = s.theta_o_nodes;
     o["phi_nodes"] = s.phi_nodes;
     o["min_cos"] = s.min_cos;
-    if (m.tolerance) {
-      m.cap = s.max_order;
-      o["tolerance"] = {{"metric", m.tolerance->metric}, {"value", m.tolerance->value}};
-    }
+    if (m.tolerance) m.cap = s.max_order;
     m.cores = hardware_cores();
     if (!r.failed()) {
       try {
@@ -1655,6 +1639,9 @@ void read_method(Reader& r, Ctx& ctx, const std::string& kind, uint64_t base_see
       }
     }
   }
+  // One rule for every kind that reads texture_size = "auto" (mccool, fit, svd).
+  if (!m.texture_ladder.empty() && !m.tolerance)
+    r.fail("texture_size", "texture_size = \"auto\" needs a tolerance (the error target that picks the size)");
   if (!r.failed() && (kind == "mccool" || kind == "fit")) {
     try {
       m.fit.validate();

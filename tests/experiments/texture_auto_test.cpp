@@ -53,6 +53,9 @@ texture_size = 12
 TEST_CASE("config: texture_size = \"auto\" misuse names the key") {
   require_error("kind = \"svd\"\ntexture_size = \"auto\"\n",
                 {"cfg.toml:", "texture_size", "needs a tolerance"});
+  require_error("kind = \"mccool\"\ntexture_size = \"auto\"\n", {"texture_size", "needs a tolerance"});
+  require_error("kind = \"fit\"\ntexture_size = \"auto\"\nprojections = [{ name = \"wi\" }]\n",
+                {"texture_size", "needs a tolerance"});
   require_error("kind = \"svd\"\ntexture_size = \"big\"\n",
                 {"texture_size", "expected an integer in 2..256 or \"auto\"", "big"});
   require_error("kind = \"svd\"\ntexture_size = 16\ntexture_ladder = [8, 16]\n"
