@@ -386,15 +386,24 @@ SearchResult search_factorization(const FitData& data, const SearchOptions& opt)
     // The first term's search cost is shared by the branches: booked on branch 0.
     add_term(data, opt, sres, b, first[order[k]], static_cast<int>(order[k]),
              k == 0 ? first_evals : 0, t1);
-    // With a stopping rule every added term is backfitted at once (the order of
-    // operations is the same as without: add, backfit, search the next term).
-    const auto stop_here = [&] {
-      if (!opt.stop_after_term) return false;
-      backfit(data, opt, sres, b);
+    // The projections found so far, refit at the final resolution (thesis 4.2).
+    std::shared_ptr<HomomorphicFactorization> f;
+    std::vector<double> errors;
+    const auto refit = [&] {
       std::vector<TermSpec> specs;
       for (const Rotation4& R : b.rotations)
         specs.push_back(TermSpec{R.projection(opt.param, opt.texture_size), opt.reciprocity, R.packed()});
-      return opt.stop_after_term(*fit_homomorphic(data, specs, opt.fit, "search"));
+      errors.clear();
+      f = fit_homomorphic(data, specs, opt.fit, "search", &errors);
+    };
+    // With a stopping rule every added term is backfitted at once (the order of
+    // operations is the same as without: add, backfit, search the next term)
+    // and refit; the last refit is the branch's result.
+    const auto stop_here = [&] {
+      if (!opt.stop_after_term) return false;
+      backfit(data, opt, sres, b);
+      refit();
+      return opt.stop_after_term(*f);
     };
     bool stopped = stop_here();
     for (int j = 1; j < opt.terms && !stopped; ++j) {
@@ -410,15 +419,11 @@ SearchResult search_factorization(const FitData& data, const SearchOptions& opt)
       add_term(data, opt, sres, b, res[best], static_cast<int>(best), evals, tj);
       stopped = stop_here();
     }
-    if (!opt.stop_after_term) backfit(data, opt, sres, b);
+    if (!opt.stop_after_term) {
+      backfit(data, opt, sres, b);
+      refit();
+    }
     out.evaluations += b.evaluations - (k == 0 ? first_evals : 0);
-
-    // Refit the found projections at the final resolution (thesis 4.2).
-    std::vector<TermSpec> final_specs;
-    for (const Rotation4& R : b.rotations)
-      final_specs.push_back(TermSpec{R.projection(opt.param, opt.texture_size), opt.reciprocity, R.packed()});
-    std::vector<double> errors;
-    auto f = fit_homomorphic(data, final_specs, opt.fit, "search", &errors);
     out.beam_rel_mse.push_back(errors.back());
     if (errors.back() < best_error) {
       best_error = errors.back();
