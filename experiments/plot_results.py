@@ -140,7 +140,8 @@ def main():
     import matplotlib.pyplot as plt
     from matplotlib.ticker import MaxNLocator
 
-    rows = [r for r in load(a.csv) if number(r.get(a.metric)) is not None]
+    all_rows = load(a.csv)
+    rows = [r for r in all_rows if number(r.get(a.metric)) is not None]
     if not rows:
         return 0
     os.makedirs(out_dir, exist_ok=True)
@@ -227,7 +228,7 @@ def main():
 
     # 4. per BRDF: error against storage and against time, one marker per method.
     for metric in OrderedDict.fromkeys([a.metric, "cos_rmse"]):
-        written += plot_by_brdf(plt, load(a.csv), metric, out_dir, formats)
+        written += plot_by_brdf(plt, all_rows, metric, out_dir, formats)
 
     for w in written:
         print("wrote " + w)
