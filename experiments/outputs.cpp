@@ -2,7 +2,6 @@
 #include "experiments/outputs.h"
 
 #include <Eigen/Core>
-#include <OpenImageIO/oiioversion.h>
 #include <ceres/version.h>
 
 #include <array>
@@ -20,6 +19,7 @@
 
 #include "experiments/cli_util.h"
 #include "experiments/report.h"
+#include "factor/image_io.h"
 
 namespace bf {
 
@@ -205,7 +205,8 @@ json software_versions() {
   v["eigen"] = std::to_string(EIGEN_WORLD_VERSION) + "." + std::to_string(EIGEN_MAJOR_VERSION) + "." +
                std::to_string(EIGEN_MINOR_VERSION);
   v["ceres"] = CERES_VERSION_STRING;
-  v["openimageio"] = OIIO_VERSION_STRING;
+  v["openexr"] = openexr_version();
+  v["libpng"] = libpng_version();
   v["tomlplusplus"] = std::to_string(TOML_LIB_MAJOR) + "." + std::to_string(TOML_LIB_MINOR) + "." +
                       std::to_string(TOML_LIB_PATCH);
   v["nlohmann_json"] = std::to_string(NLOHMANN_JSON_VERSION_MAJOR) + "." +

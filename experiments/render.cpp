@@ -1,7 +1,7 @@
 // Sphere pictures and shade_rmse (see render.h).
 #include "experiments/render.h"
 
-#include <OpenImageIO/imageio.h>
+#include "factor/image_io.h"
 
 #include <algorithm>
 #include <cmath>
@@ -158,13 +158,11 @@ void write_comparison_png(const SphereRender& original, const SphereRender& appr
   tmp_name += final_path.filename().string();
   tmp_name += ".tmp.png";
   const fs::path tmp = final_path.parent_path() / tmp_name;
-  auto out = OIIO::ImageOutput::create("png");
-  if (!out) throw std::runtime_error(path + ": OpenImageIO has no PNG writer");
-  OIIO::ImageSpec spec(W, n, 3, OIIO::TypeDesc::UINT8);
-  if (!out->open(tmp.string(), spec) || !out->write_image(OIIO::TypeDesc::UINT8, px.data()) || !out->close()) {
-    const std::string err = out->geterror();
+  try {
+    bf::write_png_rgb8(tmp.string(), W, n, px);
+  } catch (const std::exception& e) {
     std::remove(tmp.c_str());
-    throw std::runtime_error(path + ": cannot write PNG: " + err);
+    throw std::runtime_error(path + ": cannot write PNG: " + e.what());
   }
   std::error_code ec;
   fs::rename(tmp, final_path, ec);

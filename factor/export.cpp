@@ -5,7 +5,6 @@
 #include <fcntl.h>
 #include <unistd.h>
 
-#include <OpenImageIO/imageio.h>
 #include <algorithm>
 #include <array>
 #include <atomic>
@@ -17,6 +16,7 @@
 
 #include "brdfs/catalogue.h"
 #include "factor/glsl.h"
+#include "factor/image_io.h"
 #include "factor/model_fit.h"
 
 namespace bf {
@@ -86,21 +86,6 @@ void write_text(const fs::path& tmp, const fs::path& final_path, const std::stri
   out << text;
   out.close();
   if (!out) throw std::runtime_error(final_path.string() + ": write failed");
-}
-
-void write_image(const fs::path& tmp, const fs::path& final_path, const char* format,
-                 const OIIO::ImageSpec& spec, OIIO::TypeDesc type, const void* data) {
-  auto out = OIIO::ImageOutput::create(format);
-  if (!out)
-    throw std::runtime_error(final_path.string() + ": no " + format +
-                             " writer: " + OIIO::geterror());
-  if (!out->open(tmp.string(), spec))
-    throw std::runtime_error(final_path.string() + ": cannot open for writing: " +
-                             out->geterror());
-  if (!out->write_image(type, data))
-    throw std::runtime_error(final_path.string() + ": write failed: " + out->geterror());
-  if (!out->close())
-    throw std::runtime_error(final_path.string() + ": close failed: " + out->geterror());
 }
 
 // Interleaved RGB float32 texels of a term, zero outside the mask.
@@ -263,30 +248,22 @@ class Sidecar {
 
 // Reads a term's EXR into t.texels (planar), checking size, channels and values.
 void read_texture(const std::string& path, const std::string& field, FactorTerm& t) {
-  auto in = OIIO::ImageInput::open(path);
-  if (!in) {
-    std::string err = OIIO::geterror();
-    if (!fs::exists(path)) err = "file not found";
-    throw std::invalid_argument(path + " (" + field + "): cannot open texture: " + err);
-  }
-  const OIIO::ImageSpec& spec = in->spec();
   const int R = t.proj.res;
-  if (spec.width != R || spec.height != R || spec.depth != 1)
-    throw std::invalid_argument(path + ": expected " + std::to_string(R) + "x" +
-                                std::to_string(R) + " texels (" + field +
-                                " resolution in the sidecar), found " +
-                                std::to_string(spec.width) + "x" + std::to_string(spec.height) +
-                                (spec.depth != 1 ? "x" + std::to_string(spec.depth) : ""));
-  if (spec.x != 0 || spec.y != 0)
-    throw std::invalid_argument(path + ": expected the data window to start at (0, 0), found (" +
-                                std::to_string(spec.x) + ", " + std::to_string(spec.y) + ")");
-  if (spec.nchannels != 3)
-    throw std::invalid_argument(path + ": expected 3 channels (R, G, B), found " +
-                                std::to_string(spec.nchannels));
-  std::vector<float> px(size_t(R) * R * 3);
-  if (!in->read_image(0, 0, 0, 3, OIIO::TypeDesc::FLOAT, px.data()))
-    throw std::invalid_argument(path + ": cannot read pixels: " + in->geterror());
-  in->close();
+  FloatImage img;
+  try {
+    // The size is checked from the header, before any pixel is allocated.
+    const ImageSize size = read_exr_size(path);
+    if (size.width != R || size.height != R)
+      throw std::invalid_argument(path + ": expected " + std::to_string(R) + "x" +
+                                  std::to_string(R) + " texels (" + field +
+                                  " resolution in the sidecar), found " +
+                                  std::to_string(size.width) + "x" + std::to_string(size.height));
+    img = read_exr_rgb(path, false, (long long)R * R);
+  } catch (const std::invalid_argument& e) {
+    const std::string what = e.what();
+    throw std::invalid_argument(what.find(field) == std::string::npos ? what + " (" + field + ")" : what);
+  }
+  const std::vector<float>& px = img.pixels;
   for (int c = 0; c < 3; ++c) t.texels[c].assign(size_t(R) * R, 0.0f);
   for (size_t k = 0; k < size_t(R) * R; ++k)
     for (int c = 0; c < 3; ++c) {
@@ -336,22 +313,18 @@ ExportedFiles write_factorization(const HomomorphicFactorization& f, const std::
     const FactorTerm& t = terms[k];
     const int R = t.proj.res;
     {
-      OIIO::ImageSpec spec(R, R, 3, OIIO::TypeDesc::FLOAT);
-      spec.channelnames = {"R", "G", "B"};
-      spec.attribute("compression", "zip");
-      spec.attribute("ImageDescription", "brdf-factor log-space factor texture, term " +
-                                             std::to_string(k) + " of " + stem + ".json");
-      const std::vector<float> px = interleaved_texels(t);
-      write_image(batch.add(tex_names[k]), files.textures[k], "openexr", spec,
-                  OIIO::TypeDesc::FLOAT, px.data());
+      FloatImage img;
+      img.width = img.height = R;
+      img.channel_names = {"R", "G", "B"};
+      img.pixels = interleaved_texels(t);
+      write_exr(batch.add(tex_names[k]), img,
+                "brdf-factor log-space factor texture, term " + std::to_string(k) + " of " + stem +
+                    ".json");
     }
     {
       int size = 0;
       const std::vector<uint8_t> px = preview_pixels(t, size);
-      OIIO::ImageSpec spec(size, size, 3, OIIO::TypeDesc::UINT8);
-      spec.attribute("oiio:ColorSpace", "sRGB");
-      write_image(batch.add(png_names[k]), files.previews[k], "png", spec, OIIO::TypeDesc::UINT8,
-                  px.data());
+      write_png_rgb8(batch.add(png_names[k]), size, size, px);
     }
   }
 

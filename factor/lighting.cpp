@@ -1,7 +1,7 @@
 // Environment lighting, band limits, lit shading and the SHRM (see lighting.h).
 #include "factor/lighting.h"
 
-#include <OpenImageIO/imageio.h>
+#include "factor/image_io.h"
 
 #include <algorithm>
 #include <chrono>
@@ -30,28 +30,22 @@ Vec3 LatLongMap::direction(int x, int y, int width, int height) {
 }
 
 LatLongMap read_latlong(const std::string& path) {
-  auto in = OIIO::ImageInput::open(path);
-  if (!in) {
-    std::string err = OIIO::geterror();
-    if (!fs::exists(path)) err = "file not found";
-    throw std::invalid_argument(path + ": cannot open environment map: " + err);
-  }
-  const OIIO::ImageSpec& spec = in->spec();
-  const int W = spec.width, H = spec.height;
-  if (spec.depth != 1 || W != 2 * H)
+  std::string ext = fs::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  if (ext != ".exr" && ext != ".hdr" && ext != ".pic")
+    throw std::invalid_argument(path + ": environment map: expected a .exr or .hdr (Radiance) file, found '" + ext +
+                                "'");
+  // R, G, B (or one grey channel) as floats, row 0 = theta 0 (the zenith).
+  const FloatImage img = ext == ".exr" ? read_exr_rgb(path, true) : read_hdr(path);
+  const int W = img.width, H = img.height;
+  if (W != 2 * H)
     throw std::invalid_argument(path + ": environment map: expected a lat-long map with width = 2 x height, found " +
-                                std::to_string(W) + "x" + std::to_string(H) +
-                                (spec.depth != 1 ? "x" + std::to_string(spec.depth) : ""));
+                                std::to_string(W) + "x" + std::to_string(H));
   if (H < 4)
     throw std::invalid_argument(path + ": environment map: expected at least 8x4 texels, found " +
                                 std::to_string(W) + "x" + std::to_string(H));
-  const int nch = spec.nchannels;
-  if (nch < 1) throw std::invalid_argument(path + ": environment map: no channels");
-  const int used = nch >= 3 ? 3 : 1;
-  std::vector<float> px(size_t(W) * H * used);
-  if (!in->read_image(0, 0, 0, used, OIIO::TypeDesc::FLOAT, px.data()))
-    throw std::invalid_argument(path + ": environment map: cannot read pixels: " + in->geterror());
-  in->close();
+  const int used = 3;
+  const std::vector<float>& px = img.pixels;
   LatLongMap m;
   m.width = W;
   m.height = H;
@@ -72,17 +66,21 @@ LatLongMap read_latlong(const std::string& path) {
 }
 
 void write_latlong(const std::string& path, const LatLongMap& map) {
-  const std::string ext = fs::path(path).extension().string();
-  auto out = OIIO::ImageOutput::create(path);
-  if (!out) throw std::runtime_error(path + ": no writer for '" + ext + "': " + OIIO::geterror());
-  OIIO::ImageSpec spec(map.width, map.height, 3, OIIO::TypeDesc::FLOAT);
-  std::vector<float> px(map.texels.size() * 3);
+  std::string ext = fs::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  FloatImage img;
+  img.width = map.width;
+  img.height = map.height;
+  img.channel_names = {"R", "G", "B"};
+  img.pixels.resize(map.texels.size() * 3);
   for (size_t k = 0; k < map.texels.size(); ++k)
-    for (int c = 0; c < 3; ++c) px[3 * k + c] = float(map.texels[k][c]);
-  if (!out->open(path, spec)) throw std::runtime_error(path + ": cannot open for writing: " + out->geterror());
-  if (!out->write_image(OIIO::TypeDesc::FLOAT, px.data()))
-    throw std::runtime_error(path + ": write failed: " + out->geterror());
-  if (!out->close()) throw std::runtime_error(path + ": close failed: " + out->geterror());
+    for (int c = 0; c < 3; ++c) img.pixels[3 * k + c] = float(map.texels[k][c]);
+  if (ext == ".exr")
+    write_exr(path, img);
+  else if (ext == ".hdr" || ext == ".pic")
+    write_hdr(path, img);
+  else
+    throw std::runtime_error(path + ": environment map: expected a .exr or .hdr file name, found '" + ext + "'");
 }
 
 LatLongMap make_latlong(int width, int height, const std::function<Rgb(const Vec3&)>& radiance) {

@@ -1,6 +1,6 @@
 // Scene lighting for the SH baselines (issue #7 part B; notes
 // ../shared/papers/NOTES-sh-baselines-and-order-selection.md §2.1-2.2, §1.3.5):
-//  - lat-long environment maps (.exr / .hdr / anything OpenImageIO reads),
+//  - lat-long environment maps (.exr, or Radiance .hdr / .pic),
 //    projected onto real SH (solvers/sh.h convention) with exact quadrature
 //    weights for the equiangular grid;
 //  - the lighting band limit: the smallest order L capturing 1 - eps of the
@@ -41,8 +41,9 @@ struct LatLongMap {
 
 // Reads an environment map. Throws std::invalid_argument "<path>: ..." when
 // the file is missing or unreadable, not 2:1 (W = 2H), smaller than 8 x 4,
-// has fewer than 1 channel, or holds a NaN, infinite or negative texel
-// (named by x, y and channel). 1- and 2-channel maps are grey (channel 0).
+// has channels other than R, G, B or a single grey one, or holds a NaN,
+// infinite or negative texel (named by x, y and channel). A .exr is read with
+// OpenEXR, a .hdr / .pic as Radiance RGBE; other extensions are refused.
 LatLongMap read_latlong(const std::string& path);
 // Writes a map as 32-bit float RGB (format from the extension: .exr, .hdr);
 // throws std::runtime_error naming the path on failure.

@@ -13,8 +13,8 @@ PACKAGES=(
   build-essential cmake ninja-build pkg-config
   libeigen3-dev          # linear algebra (3.4)
   libceres-dev           # nonlinear least squares (2.1)
-  libopenimageio-dev     # EXR/PNG I/O (2.4)
-  libopenexr-dev         # EXR (3.1)
+  libopenexr-dev         # EXR textures and environment maps (3.1)
+  libpng-dev             # PNG previews and renders (1.6)
   libnlopt-cxx-dev       # alternative optimizers (2.7)
   catch2                 # tests (2.13)
   libtomlplusplus-dev    # TOML configs

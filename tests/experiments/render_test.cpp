@@ -1,5 +1,5 @@
 // The per-run sphere picture and shade_rmse.
-#include <OpenImageIO/imageio.h>
+#include "factor/image_io.h"
 
 #include "brdfs/catalogue.h"
 #include "experiments/render.h"
@@ -30,12 +30,11 @@ TEST_CASE("render: the sphere is lit where the light sees it, and shade_rmse com
   ScratchDir tmp;
   const std::string png = tmp / "sphere.png";
   write_comparison_png(a, b, png);
-  auto in = OIIO::ImageInput::open(png);
-  REQUIRE(in);
-  CHECK(in->spec().width == 3 * 32 + 2 * 4);
-  CHECK(in->spec().height == 32);
-  CHECK(in->spec().nchannels == 3);
-  in->close();
+  int pw = 0, ph = 0;
+  const std::vector<uint8_t> px = bf::read_png_rgb8(png, pw, ph);
+  CHECK(pw == 3 * 32 + 2 * 4);
+  CHECK(ph == 32);
+  CHECK(px.size() == size_t(pw) * ph * 3);
   // Nothing but the picture is left in the folder (no temporary).
   size_t files = 0;
   for (const auto& e : fs::directory_iterator(tmp.path)) files += e.is_regular_file();
