@@ -38,11 +38,13 @@ int main(int argc, char** argv) {
     const bf::FitData data(s, 1e-5);
     const auto f = bf::fit_homomorphic(data, bf::mccool_terms(texture), bf::FitOptions{}, "mccool");
     const auto t1 = Clock::now();
-    // The same loop as the module's Brdf.eval: normalize, evaluate.
+    // The same loop as the module's Brdf.eval: normalize (unless unit to 1e-14), evaluate.
     for (size_t k = 0; k < n; ++k) {
       const bf::Vec3 wi(dirs[6 * k], dirs[6 * k + 1], dirs[6 * k + 2]);
       const bf::Vec3 wo(dirs[6 * k + 3], dirs[6 * k + 4], dirs[6 * k + 5]);
-      const bf::Rgb v = f->eval(wi / wi.norm(), wo / wo.norm());
+      const double li = wi.norm(), lo = wo.norm();
+      const bf::Rgb v = f->eval(std::abs(li - 1.0) <= 1e-14 ? wi : bf::Vec3(wi / li),
+                                std::abs(lo - 1.0) <= 1e-14 ? wo : bf::Vec3(wo / lo));
       out[3 * k] = v[0];
       out[3 * k + 1] = v[1];
       out[3 * k + 2] = v[2];

@@ -61,7 +61,9 @@ py::array_t<double> eval_pairs(const Brdf& b, const py::handle& wi_in, const py:
         bad_o = k;
         break;
       }
-      const Rgb f = b.eval(a / la, c / lc);
+      // Unit directions (to 1e-14) are used as given, so that values at a
+      // sample set's own directions are bit-identical to its values.
+      const Rgb f = b.eval(std::abs(la - 1.0) <= 1e-14 ? a : Vec3(a / la), std::abs(lc - 1.0) <= 1e-14 ? c : Vec3(c / lc));
       pr[3 * k] = f[0];
       pr[3 * k + 1] = f[1];
       pr[3 * k + 2] = f[2];
@@ -90,7 +92,8 @@ light, wo towards the viewer; values in 1/sr, linear RGB, without the cosine;
           py::arg("wi"), py::arg("wo"),
           R"doc(f(wi, wo) for arrays of directions: wi, wo (N, 3) (or one of them (3,),
 used for every pair), normalized here as the CLI's eval does; returns (N, 3)
-float64 RGB in 1/sr ((3,) when both are (3,)). The GIL is released.)doc")
+float64 RGB in 1/sr ((3,) when both are (3,)). Directions of unit length
+(to 1e-14) are used as given. The GIL is released.)doc")
       .def("__call__", [](const PyBrdf& self, const py::handle& wi, const py::handle& wo) { return eval_pairs(*self.brdf, wi, wo); },
            py::arg("wi"), py::arg("wo"))
       .def_property_readonly("name", [](const PyBrdf& self) { return self.brdf->name(); })

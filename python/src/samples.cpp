@@ -52,11 +52,11 @@ SamplesPtr from_arrays(const py::handle& wi_in, const py::handle& wo_in, const p
   std::copy_n(wo.data(), 3 * n, s->wo.front().data());
   std::copy_n(value.data(), 3 * n, s->value.front().data());
   for (py::ssize_t k = 0; k < n; ++k) {
-    // Directions are normalized as everywhere else in the module; zero ones
+    // Directions are normalized as in Brdf.eval (unit ones kept as given); zero ones
     // become NaN and are masked by validate() as below the horizon.
     const double li = s->wi[k].norm(), lo = s->wo[k].norm();
-    s->wi[k] /= li;
-    s->wo[k] /= lo;
+    if (std::abs(li - 1.0) > 1e-14) s->wi[k] /= li;
+    if (std::abs(lo - 1.0) > 1e-14) s->wo[k] /= lo;
   }
   if (weight) s->weight.assign(weight.data(), weight.data() + n);
   s->description = description;

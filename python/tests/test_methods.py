@@ -11,7 +11,7 @@ from conftest import random_pairs
 METRICS = {"rel_mse", "rel_mae", "rel_max", "lin_rmse", "lin_mae", "lin_max", "cos_rmse", "samples"}
 
 
-def check_report(f, samples, method):
+def check_report(f, samples, method, nonnegative=True):
     assert isinstance(f, bf.Factorization) and isinstance(f, bf.Brdf)
     assert f.method == method
     assert set(f.metrics) == METRICS and f.metrics["samples"] == samples.valid_count
@@ -21,7 +21,9 @@ def check_report(f, samples, method):
     assert f.storage_floats > 0 and f.seconds >= 0
     wi, wo = random_pairs(500)
     v = f.eval(wi, wo)
-    assert v.shape == (500, 3) and np.all(np.isfinite(v)) and np.all(v >= 0)
+    assert v.shape == (500, 3) and np.all(np.isfinite(v))
+    # SH series ring (negative lobes, factor/sh_baseline.h pitfall P1); the others clamp at 0.
+    assert np.all(v >= 0) or not nonnegative
 
 
 def test_mccool_recovers_a_planted_mccool_form():
@@ -85,11 +87,11 @@ def test_svd_of_a_rank_one_brdf_is_exact_at_rank_one():
 def test_sh_k_and_sh_r(grid8, bluepaint):
     k2 = bf.sh_k(bluepaint, grid8, order=2, texture_size=8)
     k6 = bf.sh_k(bluepaint, grid8, order=6, texture_size=8)
-    check_report(k6, grid8, "sh-k")
+    check_report(k6, grid8, "sh-k", nonnegative=False)
     # A higher band limit approximates the product function better.
     assert k6.metrics["cos_rmse"] < k2.metrics["cos_rmse"]
     r = bf.sh_r(bluepaint, grid8, order=8, view_order=2, max_order=8, max_view_order=2)
-    check_report(r, grid8, "sh-r")
+    check_report(r, grid8, "sh-r", nonnegative=False)
     with pytest.raises(ValueError, match=r"^sh-r: order: fixed orders need both order and view_order"):
         bf.sh_r(bluepaint, order=4)
 
