@@ -36,6 +36,7 @@ from ._core import (  # noqa: F401  (the public API)
     run_experiment as _run_experiment,
     sample_grid,
     sample_stratified,
+    score,
     search,
     sh_k,
     sh_r,
@@ -46,7 +47,7 @@ __all__ = [
     "Brdf", "ConfigError", "Factorization", "SampleSet", "brdf", "data_dir", "evaluate",
     "factor", "file_formats", "fit", "load", "mccool", "measured_samples", "model_fit",
     "models", "presets", "read_samples", "refine", "results", "run", "sample_grid",
-    "sample_stratified", "search", "sh_k", "sh_r", "svd", "METHODS",
+    "sample_stratified", "score", "search", "sh_k", "sh_r", "svd", "METHODS",
 ]
 
 # Method kinds as the configs name them -> the function and what it factors

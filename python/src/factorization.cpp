@@ -135,6 +135,16 @@ load(sidecar) reads it back (bit-identical evaluation).)doc")
       });
 
   m.def(
+      "score",
+      [](const PyBrdf& approx, const SampleSet& s, double eps) {
+        py::gil_scoped_release release;
+        const Metrics mt = evaluate_metrics(*approx.brdf, s, LogTransform::of(s, eps));
+        py::gil_scoped_acquire gil;
+        return metrics_dict(mt);
+      },
+      py::arg("approx"), py::arg("samples"), py::arg("metric_eps") = 1e-5,
+      "Metrics (DESIGN.md §4) of any BRDF (a factorization, a model, a reloaded export) on a sample set.");
+  m.def(
       "load",
       [](const std::string& path) -> py::object {
         std::string format;

@@ -47,6 +47,25 @@ terms = 2
 texture_size = 8
 
 [[method]]
+kind = "sh-k"
+order = 4
+texture_size = 8
+
+[[method]]
+kind = "sh-r"
+order = 8
+view_order = 2
+max_order = 8
+max_view_order = 2
+
+[[method]]
+kind = "mccool"
+label = "mccool+refine"
+texture_size = 8
+refine = "linear"
+refine_iterations = 5
+
+[[method]]
 kind = "model-fit"
 model = "blinn-phong"
 starts = 2
@@ -59,8 +78,12 @@ DIRECT = {
     "fit": lambda s, b: bf.fit(s, projections=["wi", "h"], texture_size=8),
     "search": lambda s, b: bf.search(s, terms=2, texture_size=8, restarts=2, threads=1, seed=1),
     "svd": lambda s, b: bf.svd(b, s, terms=2, texture_size=8),
+    "sh-k": lambda s, b: bf.sh_k(b, s, order=4, texture_size=8),
+    "sh-r": lambda s, b: bf.sh_r(b, s, order=8, view_order=2, max_order=8, max_view_order=2),
+    "mccool+refine": lambda s, b: bf.mccool(s, texture_size=8, refine="linear", refine_iterations=5),
     "model-fit": lambda s, b: bf.model_fit(s, model="blinn-phong", starts=2, threads=1, seed=1),
 }
+KINDS = ["mccool", "fit", "search", "svd", "sh-k", "sh-r", "mccool", "model-fit"]
 
 
 @pytest.fixture(scope="module")
@@ -78,21 +101,21 @@ def runs(tmp_path_factory, cli):
 
 def test_run_summary(runs):
     cli_out, py_out, s = runs
-    assert s["planned"] == 5 and s["executed"] == 5 and s["failed"] == 0
+    assert s["planned"] == 8 and s["executed"] == 8 and s["failed"] == 0
     assert s["out_dir"] == str(py_out)
     rows = s.results()
-    assert [r["method"] for r in rows] == ["mccool", "fit", "search", "svd", "model-fit"]
+    assert [r["method"] for r in rows] == KINDS
     assert all(isinstance(r["rel_mse"], float) for r in rows)
     # Run again: every run comes from the cache.
     again = bf.run(cli_out.parent / "pycheck.toml", out=py_out)
-    assert again["cached"] == 5 and again["executed"] == 0
+    assert again["cached"] == 8 and again["executed"] == 0
 
 
 def test_results_equal_the_cli(runs):
     cli_out, py_out, _ = runs
     a = bf.results(cli_out)
     b = bf.results(py_out)
-    assert len(a) == len(b) == 5
+    assert len(a) == len(b) == 8
     for ra, rb in zip(a, b):
         assert ra["run_id"] == rb["run_id"]
         for k in ("rel_mse", "rel_mae", "rel_max", "lin_rmse", "cos_rmse", "storage_floats", "samples"):
@@ -103,11 +126,15 @@ def test_direct_api_equals_the_cli(runs, bluepaint):
     cli_out, _, _ = runs
     s = bf.sample_grid(bluepaint, 8)
     for row in bf.results(cli_out):
-        kind = row["method"]
+        kind = row["label"]
         f = DIRECT[kind](s, bluepaint)
         # results.csv holds 9 significant digits.
         assert f.metrics["rel_mse"] == pytest.approx(row["rel_mse"], rel=1e-8, abs=0), kind
         assert f.storage_floats == row["storage_floats"], kind
+        model = cli_out / "runs" / row["run_id"] / "model.json"
+        if model.exists():
+            # The CLI's model fit, rebuilt from its spec and scored at full precision.
+            assert abs(bf.score(bf.load(str(model)), s)["rel_mse"] - f.metrics["rel_mse"]) <= 1e-12, kind
         sidecar = cli_out / "runs" / row["run_id"] / "factors.json"
         if sidecar.exists():
             # The CLI's exported factorization, scored here at full precision.
@@ -134,11 +161,11 @@ def test_config_errors_carry_the_cli_message(tmp_path, cli):
 def test_defines_and_frame(runs, tmp_path):
     cli_out, _, _ = runs
     s = bf.run(cli_out.parent / "pycheck.toml", out=tmp_path / "d", defines={"sampling.resolution": 6}, dry_run=True)
-    assert s["planned"] == 5 and s["executed"] == 0
+    assert s["planned"] == 8 and s["executed"] == 0
     try:
         import pandas  # noqa: F401
     except ImportError:
         with pytest.raises(ImportError):
             bf.results(cli_out, frame=True)
     else:
-        assert len(bf.results(cli_out, frame=True)) == 5
+        assert len(bf.results(cli_out, frame=True)) == 8

@@ -1,4 +1,4 @@
-// The C++ side of python/bench_eval.py: the factor-and-evaluate round trip
+// The C++ side of python/bench/bench_eval.py: the factor-and-evaluate round trip
 // (McCool fit on the res^4 grid, then f(wi, wo) at N direction pairs) timed in
 // C++, to compare with the same round trip through the Python module.
 //   bench-eval-cpp BRDF GRID TEXTURE DIRS.bin OUT.bin

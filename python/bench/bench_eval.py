@@ -6,7 +6,7 @@ the evaluation (direction generation and file I/O excluded); the variants run
 interleaved, REPS times each, and the medians and their ratio are printed
 with the load. The two sides' values are checked to be identical.
 
-    PYTHONPATH=build/python /usr/bin/python3 python/bench_eval.py \\
+    PYTHONPATH=build/python /usr/bin/python3 python/bench/bench_eval.py \\
         [--cpp build/python/bench-eval-cpp] [--n 1000000] [--reps 7]
 """
 import argparse
@@ -25,7 +25,7 @@ import brdf_factor as bf
 
 
 def main():
-    here = pathlib.Path(bf.__file__).resolve().parent.parent
+    here = pathlib.Path(bf.__file__).resolve().parent.parent  # <build>/python
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--cpp", default=str(here / "bench-eval-cpp"), help="the C++ side (built with the module)")
     ap.add_argument("--brdf", default="bluepaint")
