@@ -12,13 +12,17 @@ namespace {
 // One override value as the catalogue's "k=v" syntax writes it: numbers in
 // Python's shortest round-trip form, booleans as true/false, RGB triples as r/g/b.
 std::string override_text(const std::string& key, const py::handle& v) {
+  // A 0-d numpy array is its scalar; other arrays are lists (numpy arrays
+  // also pass the index and float checks below).
+  if (py::isinstance<py::array>(v) && py::array(py::reinterpret_borrow<py::object>(v)).ndim() == 0)
+    return override_text(key, v.attr("item")());
+  if (py::isinstance<py::array>(v)) return override_text(key, v.attr("tolist")());
   if (py::isinstance<py::bool_>(v)) return v.cast<bool>() ? "true" : "false";
   if (py::isinstance<py::str>(v)) return v.cast<std::string>();
   if (PyIndex_Check(v.ptr())) return py::str(py::int_(py::reinterpret_borrow<py::object>(v)));
-  if (PyFloat_Check(v.ptr()) || py::hasattr(v, "__float__")) {
-    if (!py::isinstance<py::array>(v)) return py::repr(py::float_(py::reinterpret_borrow<py::object>(v)));
-  }
-  if (py::isinstance<py::sequence>(v) || py::isinstance<py::array>(v)) {
+  if (PyFloat_Check(v.ptr()) || py::hasattr(v, "__float__"))
+    return py::repr(py::float_(py::reinterpret_borrow<py::object>(v)));
+  if (py::isinstance<py::sequence>(v)) {
     std::string out;
     for (auto e : py::reinterpret_borrow<py::object>(v)) {
       if (py::isinstance<py::sequence>(e) && !py::isinstance<py::str>(e))

@@ -133,7 +133,7 @@ RefineStage read_refine(Options& o) {
 }
 void validate_refine(const Options& o, RefineStage& s, const FitOptions& fit) {
   if (s.ro.smoothing < 0) s.ro.smoothing = fit.smoothing;
-  if (s.refine == "none") return;
+  // Checked even with refine = "none", as the config does (a sweep over refine may carry them).
   validated(o, [&] {
     try {
       s.ro.validate();

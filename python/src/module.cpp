@@ -114,9 +114,10 @@ int Options::integer(const std::string& key, int def) {
   if (o.is_none()) return def;
   // bool is an int subclass in Python; numpy integers have __index__.
   if (py::isinstance<py::bool_>(o) || !PyIndex_Check(o.ptr())) type_error(key, "an integer", o);
-  const long long v = py::int_(o).cast<long long>();
-  if (v < -2147483647LL || v > 2147483647LL) fail(key + ": expected an integer of at most 2^31 - 1 in magnitude, found " + std::to_string(v));
-  return static_cast<int>(v);
+  const py::int_ i(o);
+  if (i < py::int_(-2147483647LL) || i > py::int_(2147483647LL))
+    fail(key + ": expected an integer of at most 2^31 - 1 in magnitude, found " + std::string(py::str(o)));
+  return i.cast<int>();
 }
 
 uint64_t Options::seed(const std::string& key, uint64_t def) {
@@ -124,7 +125,7 @@ uint64_t Options::seed(const std::string& key, uint64_t def) {
   if (o.is_none()) return def;
   if (py::isinstance<py::bool_>(o) || !PyIndex_Check(o.ptr())) type_error(key, "an integer", o);
   const py::int_ i(o);
-  if (py::int_(i) < py::int_(0) || py::int_(i) > py::int_(9223372036854775807LL))
+  if (i < py::int_(0) || i > py::int_(9223372036854775807LL))
     fail(key + ": expected an integer in 0..2^63 - 1, found " + std::string(py::str(o)));
   return i.cast<uint64_t>();
 }

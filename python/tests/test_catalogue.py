@@ -42,6 +42,9 @@ def test_overrides_equal_the_spec_string():
     b = bf.brdf("cook-torrance:m=0.2,kd=0.1/0.2/0.3")
     np.testing.assert_array_equal(a.eval(wi, wo), b.eval(wi, wo))
     assert a.to_string() == b.to_string()
+    # numpy values work as overrides too.
+    e = bf.brdf("cook-torrance", m=np.float64(0.2), kd=np.array([0.1, 0.2, 0.3]))
+    np.testing.assert_array_equal(e.eval(wi, wo), b.eval(wi, wo))
     # Overrides of a preset and of a spec with assignments.
     c = bf.brdf("cole-cook-torrance", m=0.25)
     d = bf.brdf("cole-cook-torrance:m=0.25")

@@ -127,6 +127,8 @@ def test_unknown_and_mistyped_options_are_named(grid8):
         bf.mccool(grid8, texture_size=1)
     with pytest.raises(ValueError, match=r"^search: restarts: expected an integer, found '2' \(str\)$"):
         bf.search(grid8, restarts="2")
+    with pytest.raises(ValueError, match=r"^search: terms: expected an integer of at most 2\^31 - 1 in magnitude, found 4294967296$"):
+        bf.search(grid8, terms=2**32)
     with pytest.raises(ValueError, match=r"^svd: log: expected True or False, found 1 \(int\)$"):
         bf.svd(bf.brdf("lambert"), log=1)
     # Rules of the options' validate(), as the configs apply them.
