@@ -8,6 +8,7 @@
 #include <pybind11/stl.h>
 
 #include <nlohmann/json.hpp>
+#include <limits>
 #include <map>
 #include <optional>
 #include <stdexcept>
@@ -78,9 +79,14 @@ class Options {
  public:
   Options(std::string kind, const py::kwargs& kw);
   bool has(const std::string& key) const { return values_.count(key) > 0; }
-  int integer(const std::string& key, int def);
+  // Ranges are the config reader's (experiments/config.cpp), worded as it
+  // words them ("expected an integer in 1..64, found 0", "expected a number
+  // >= 0, found -1"), so a range violation reads as in the CLI's message.
+  static constexpr long long kNoLimit = std::numeric_limits<long long>::max();
+  int integer(const std::string& key, int def, long long lo = -kNoLimit, long long hi = kNoLimit);
   uint64_t seed(const std::string& key, uint64_t def);
-  double number(const std::string& key, double def);
+  double number(const std::string& key, double def, double lo = -std::numeric_limits<double>::infinity(),
+                double hi = std::numeric_limits<double>::infinity(), bool lo_open = false);
   bool boolean(const std::string& key, bool def);
   std::string text(const std::string& key, const std::string& def);
   std::string choice(const std::string& key, const std::string& def, const std::vector<std::string>& allowed);

@@ -1,7 +1,8 @@
 // Every method kind in Python: mccool, fit, search, svd, sh_k, sh_r,
 // model_fit and refine. Keyword options carry the config keys' names
-// (docs/experiments.md) and fill the option structs of factor/ and search/,
-// whose validate() applies the configs' rules; each call then does what the
+// (docs/experiments.md), their types and ranges as the config reader checks
+// them, and fill the option structs of factor/ and search/, whose validate()
+// applies the configs' rules; each call then does what the
 // runner does for one run (experiments/runner.cpp execute_run) with the GIL
 // released, and reports metrics on the samples like a results row.
 #include <chrono>
@@ -71,10 +72,10 @@ std::optional<Tolerance> read_tolerance(Options& o) {
 }
 
 void read_fit_options(Options& o, FitOptions& f) {
-  f.eps = o.number("eps", f.eps);
-  f.smoothing = o.number("smoothing", f.smoothing);
+  f.eps = o.number("eps", f.eps, 0.0, 1.0, true);
+  f.smoothing = o.number("smoothing", f.smoothing, 0.0);
   f.subtract_eps = o.boolean("subtract_eps", f.subtract_eps);
-  f.solve_last = o.integer("solve_last", f.solve_last);
+  f.solve_last = o.integer("solve_last", f.solve_last, 1, 64);
   const std::string solver = o.choice("solver", "auto", {"auto", "dense", "sparse", "qr"});
   f.solver = solver == "dense"    ? FitOptions::Solver::Dense
              : solver == "sparse" ? FitOptions::Solver::Sparse
@@ -125,9 +126,9 @@ RefineStage read_refine(Options& o) {
   RefineStage s;
   s.refine = o.choice("refine", "none", {"none", "linear", "cosine", "blend"});
   if (s.refine != "none") s.ro.objective = s.refine;
-  s.ro.blend_weight = o.number("refine_blend", s.ro.blend_weight);
-  s.ro.max_iterations = o.integer("refine_iterations", s.ro.max_iterations);
-  s.ro.smoothing = o.number("refine_smoothing", -1.0);  // -1: the fit's smoothing
+  s.ro.blend_weight = o.number("refine_blend", s.ro.blend_weight, 0.0);
+  s.ro.max_iterations = o.integer("refine_iterations", s.ro.max_iterations, 1, 100000);
+  s.ro.smoothing = o.has("refine_smoothing") ? o.number("refine_smoothing", 0.0, 0.0) : -1.0;  // -1: the fit's smoothing
   s.ro.threads = 1;  // as the runner
   return s;
 }
@@ -144,9 +145,7 @@ void validate_refine(const Options& o, RefineStage& s, const FitOptions& fit) {
 }
 
 double read_metric_eps(Options& o) {
-  const double e = o.number("metric_eps", 1e-5);
-  if (!(e > 0 && e <= 1)) o.fail("metric_eps: expected 0 < metric_eps <= 1, found " + std::to_string(e));
-  return e;
+  return o.number("metric_eps", 1e-5, 0.0, 1.0, true);
 }
 
 json refine_record(const RefineReport& rep, const RefineOptions& ro) {
@@ -323,10 +322,10 @@ std::shared_ptr<PyFactorization> run_fit(const SampleSet& s, const py::kwargs& k
   const std::vector<TermSpec> projections = read_projections(o, param, reciprocity, res);
   const int n = static_cast<int>(projections.size());
   const bool has_terms = o.has("terms");
-  const int terms = o.integer("terms", n);
-  if (terms < 1 || terms > n)
-    o.fail("terms: expected 1.." + std::to_string(n) + " (terms uses the first `terms` of the " + std::to_string(n) +
-           " projections), found " + std::to_string(terms));
+  const int terms = o.integer("terms", n, 1, 1024);
+  if (terms > n)
+    o.fail("terms: terms = " + std::to_string(terms) + " but only " + std::to_string(n) +
+           " projections are given (terms uses the first `terms` of them)");
   const int cap = has_terms ? terms : n;
   RefineStage st = read_refine(o);
   const double metric_eps = read_metric_eps(o);
@@ -355,22 +354,23 @@ std::shared_ptr<PyFactorization> run_search(const SampleSet& s, const py::kwargs
   SearchOptions so;
   so.param = read_param(o, so.param);
   const std::optional<Tolerance> tol = read_tolerance(o);
-  so.terms = o.integer("terms", tol ? 8 : so.terms);
-  so.texture_size = o.integer("texture_size", so.texture_size);
-  so.search_texture_size = o.integer("search_texture_size", 0);
-  so.restarts = o.integer("restarts", so.restarts);
+  so.terms = o.integer("terms", tol ? 8 : so.terms, 1, 64);
+  so.texture_size = o.integer("texture_size", so.texture_size, 2, 1024);
+  so.search_texture_size = o.integer("search_texture_size", 0, 0, 1024);
+  if (so.search_texture_size == 1) o.fail("search_texture_size: expected 0 (same as texture_size) or 2..1024, found 1");
+  so.restarts = o.integer("restarts", so.restarts, 0, 100000);
   so.guesses = o.texts("guesses");
   so.reciprocity = o.boolean("reciprocity", false);
   so.optimizer = o.choice("optimizer", so.optimizer, {"powell", "praxis", "bobyqa", "neldermead", "sbplx", "direct", "crs"});
-  so.powell.ftol = o.number("ftol", so.powell.ftol);
-  so.powell.line_tol = o.number("line_tol", so.powell.line_tol);
-  so.powell.initial_step = o.number("initial_step", so.powell.initial_step);
-  so.powell.max_sweeps = o.integer("max_sweeps", so.powell.max_sweeps);
-  so.powell.max_evaluations = o.integer("max_evaluations", so.powell.max_evaluations);
-  so.threads = o.integer("threads", 0);
-  so.beam = o.integer("beam", so.beam);
-  so.backfit_sweeps = o.integer("backfit_sweeps", so.backfit_sweeps);
-  so.backfit_restarts = o.integer("backfit_restarts", so.backfit_restarts);
+  so.powell.ftol = o.number("ftol", so.powell.ftol, 0.0, 1.0, true);
+  so.powell.line_tol = o.number("line_tol", so.powell.line_tol, 0.0, 10.0, true);
+  so.powell.initial_step = o.number("initial_step", so.powell.initial_step, 0.0, 10.0, true);
+  so.powell.max_sweeps = o.integer("max_sweeps", so.powell.max_sweeps, 1, 100000);
+  so.powell.max_evaluations = o.integer("max_evaluations", so.powell.max_evaluations, 10, 100000000);
+  so.threads = o.integer("threads", 0, 0, 1024);
+  so.beam = o.integer("beam", so.beam, 1, 100000);
+  so.backfit_sweeps = o.integer("backfit_sweeps", so.backfit_sweeps, 0, 1000);
+  so.backfit_restarts = o.integer("backfit_restarts", so.backfit_restarts, 0, 100000);
   so.seed = o.seed("seed", 1);
   read_fit_options(o, so.fit);
   RefineStage st = read_refine(o);
@@ -381,9 +381,6 @@ std::shared_ptr<PyFactorization> run_search(const SampleSet& s, const py::kwargs
            std::to_string(so.beam));
   validated(o, [&] { so.validate(); });
   validate_refine(o, st, so.fit);
-  // The ranges the config checks beyond validate() (values that validate() lets through).
-  if (so.powell.line_tol <= 0 || so.powell.initial_step <= 0)
-    o.fail(std::string(so.powell.line_tol <= 0 ? "line_tol" : "initial_step") + ": expected > 0");
 
   py::gil_scoped_release release;
   const auto t0 = Clock::now();
@@ -446,15 +443,15 @@ std::shared_ptr<PyFactorization> run_svd(const PyBrdf& b, const py::object& samp
   v.res = read_texture_size(o, v.res, 256, ladder);
   const std::optional<Tolerance> tol = read_tolerance(o);
   if (!tol && !ladder.empty()) o.fail("texture_size: texture_size = \"auto\" needs a tolerance (the error target that picks the size)");
-  v.rank = o.integer("terms", tol ? 16 : v.rank);
+  v.rank = o.integer("terms", tol ? 16 : v.rank, 1, 100000);
   v.param = read_param(o, v.param);
   v.log = o.boolean("log", v.log);
   if (!v.log)
     for (const char* k : {"eps", "subtract_eps"})
       if (o.has(k)) o.fail(std::string(k) + ": applies only to the log-space SVD: set log = True or remove " + k);
-  v.eps = o.number("eps", v.eps);
+  v.eps = o.number("eps", v.eps, 0.0, 1.0, true);
   v.subtract_eps = o.boolean("subtract_eps", v.subtract_eps);
-  v.rim_inset = o.number("rim_inset", v.rim_inset);
+  v.rim_inset = o.number("rim_inset", v.rim_inset, 0.0, 0.5);
   v.extend_below_horizon = o.boolean("extend_below_horizon", v.extend_below_horizon);
   v.float_textures = o.boolean("float_textures", v.float_textures);
   const double metric_eps = read_metric_eps(o);
@@ -481,12 +478,12 @@ std::shared_ptr<PyFactorization> run_shk(const PyBrdf& b, const py::object& samp
   Options o("sh-k", kw);
   ShkOptions k;
   const std::optional<Tolerance> tol = read_tolerance(o);
-  k.order = o.integer("order", tol ? 30 : k.order);
-  k.view_res = o.integer("texture_size", k.view_res);
-  k.theta_nodes = o.integer("theta_nodes", 0);
-  k.phi_nodes = o.integer("phi_nodes", 0);
-  k.rim_inset = o.number("rim_inset", k.rim_inset);
-  k.min_cos = o.number("min_cos", k.min_cos);
+  k.order = o.integer("order", tol ? 30 : k.order, 0, 200);
+  k.view_res = o.integer("texture_size", k.view_res, 2, 512);
+  k.theta_nodes = o.integer("theta_nodes", 0, 0, 100000);
+  k.phi_nodes = o.integer("phi_nodes", 0, 0, 100000);
+  k.rim_inset = o.number("rim_inset", k.rim_inset, 0.0, 0.1, true);
+  k.min_cos = o.number("min_cos", k.min_cos, 0.0, 1.0, true);
   k.float_textures = o.boolean("float_textures", k.float_textures);
   const bool reduce = o.boolean("reduce_isotropic", true);
   const double metric_eps = read_metric_eps(o);
@@ -516,10 +513,10 @@ std::shared_ptr<PyFactorization> run_shr(const PyBrdf& b, const py::object& samp
   ShrOptions s;
   const std::optional<Tolerance> tol = read_tolerance(o);
   const bool has_order = o.has("order"), has_view = o.has("view_order");
-  s.max_order = o.integer("max_order", s.max_order);
-  s.max_view_order = o.integer("max_view_order", s.max_view_order);
-  s.order = o.integer("order", -1);
-  s.view_order = o.integer("view_order", -1);
+  s.max_order = o.integer("max_order", s.max_order, 0, 400);
+  s.max_view_order = o.integer("max_view_order", s.max_view_order, 0, 100);
+  s.order = o.integer("order", -1, 0, 400);
+  s.view_order = o.integer("view_order", -1, 0, 100);
   if (has_order != has_view)
     o.fail(std::string(has_order ? "order" : "view_order") +
            ": fixed orders need both order and view_order (or neither: orders chosen by energy_eps or tolerance)");
@@ -527,11 +524,11 @@ std::shared_ptr<PyFactorization> run_shr(const PyBrdf& b, const py::object& samp
     o.fail("tolerance: tolerance chooses the orders: remove order/view_order (the caps are max_order, max_view_order)");
   if (o.has("energy_eps") && (has_order || tol))
     o.fail("energy_eps: energy_eps chooses the orders; it contradicts fixed orders or a tolerance");
-  s.energy_eps = o.number("energy_eps", s.energy_eps);
-  s.theta_i_nodes = o.integer("theta_i_nodes", 0);
-  s.theta_o_nodes = o.integer("theta_o_nodes", 0);
-  s.phi_nodes = o.integer("phi_nodes", 0);
-  s.min_cos = o.number("min_cos", s.min_cos);
+  s.energy_eps = o.number("energy_eps", s.energy_eps, 0.0, 1.0, true);
+  s.theta_i_nodes = o.integer("theta_i_nodes", 0, 0, 100000);
+  s.theta_o_nodes = o.integer("theta_o_nodes", 0, 0, 100000);
+  s.phi_nodes = o.integer("phi_nodes", 0, 0, 100000);
+  s.min_cos = o.number("min_cos", s.min_cos, 0.0, 1.0, true);
   const double metric_eps = read_metric_eps(o);
   o.finish();
   validated(o, [&] { s.validate(); });
@@ -559,12 +556,12 @@ std::shared_ptr<PyFactorization> run_model_fit(const SampleSet& s, const py::kwa
   if (f.cube_root && f.metric != "cosine")
     o.fail("cube_root: cube_root = True applies to metric = \"cosine\" only, found metric = \"" + f.metric + "\"");
   f.anisotropic = o.boolean("anisotropic", f.anisotropic);
-  f.lobes = o.integer("lobes", f.lobes);
-  f.eps = o.number("eps", f.eps);
-  f.starts = o.integer("starts", f.starts);
+  f.lobes = o.integer("lobes", f.lobes, 1, 3);
+  f.eps = o.number("eps", f.eps, 0.0, 1.0, true);
+  f.starts = o.integer("starts", f.starts, 1, 1000);
   f.seed = o.seed("seed", 1);
-  f.max_iterations = o.integer("max_iterations", f.max_iterations);
-  f.threads = o.integer("threads", 0);
+  f.max_iterations = o.integer("max_iterations", f.max_iterations, 1, 100000);
+  f.threads = o.integer("threads", 0, 0, 1024);
   const double metric_eps = read_metric_eps(o);
   o.finish();
   validated(o, [&] { check_model_fit(f); });

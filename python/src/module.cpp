@@ -1,6 +1,7 @@
 // brdf_factor._core: the module definition, exception translation and the
 // shared helpers of common.h (option reading, conversions, Ctrl-C).
 #include <algorithm>
+#include <cmath>
 #include <sstream>
 
 #include "brdfs/catalogue.h"
@@ -109,35 +110,66 @@ void Options::type_error(const std::string& key, const std::string& expected, co
   fail(key + ": expected " + expected + ", found " + shown(found));
 }
 
-int Options::integer(const std::string& key, int def) {
+namespace {
+
+std::string fmt_num(double v) {  // as the config reader prints numbers
+  std::ostringstream ss;
+  ss.precision(12);
+  ss << v;
+  return ss.str();
+}
+
+std::string range_int(long long lo, long long hi) {
+  if (lo == -Options::kNoLimit) return "";
+  if (hi == Options::kNoLimit) return " >= " + std::to_string(lo);
+  return " in " + std::to_string(lo) + ".." + std::to_string(hi);
+}
+
+std::string range_num(double lo, double hi, bool lo_open) {
+  if (std::isinf(lo) && std::isinf(hi)) return "";
+  if (std::isinf(hi)) return std::string(lo_open ? " > " : " >= ") + fmt_num(lo);
+  return std::string(" in ") + (lo_open ? "(" : "[") + fmt_num(lo) + ", " + fmt_num(hi) + "]";
+}
+
+}  // namespace
+
+int Options::integer(const std::string& key, int def, long long lo, long long hi) {
   py::object o = take(key);
   if (o.is_none()) return def;
+  const std::string range = range_int(lo, hi);
   // bool is an int subclass in Python; numpy integers have __index__.
-  if (py::isinstance<py::bool_>(o) || !PyIndex_Check(o.ptr())) type_error(key, "an integer", o);
+  if (py::isinstance<py::bool_>(o) || !PyIndex_Check(o.ptr())) type_error(key, "an integer" + range, o);
   const py::int_ i(o);
-  if (i < py::int_(-2147483647LL) || i > py::int_(2147483647LL))
-    fail(key + ": expected an integer of at most 2^31 - 1 in magnitude, found " + std::string(py::str(o)));
+  if (range.empty()) {
+    if (i < py::int_(-2147483647LL) || i > py::int_(2147483647LL))
+      fail(key + ": expected an integer of at most 2^31 - 1 in magnitude, found " + std::string(py::str(o)));
+  } else if (i < py::int_(lo) || i > py::int_(hi)) {
+    fail(key + ": expected an integer" + range + ", found " + std::string(py::str(o)));
+  }
   return i.cast<int>();
 }
 
 uint64_t Options::seed(const std::string& key, uint64_t def) {
   py::object o = take(key);
   if (o.is_none()) return def;
-  if (py::isinstance<py::bool_>(o) || !PyIndex_Check(o.ptr())) type_error(key, "an integer", o);
+  if (py::isinstance<py::bool_>(o) || !PyIndex_Check(o.ptr())) type_error(key, "an integer >= 0", o);
   const py::int_ i(o);
   if (i < py::int_(0) || i > py::int_(9223372036854775807LL))
-    fail(key + ": expected an integer in 0..2^63 - 1, found " + std::string(py::str(o)));
+    fail(key + ": expected an integer >= 0, found " + std::string(py::str(o)));
   return i.cast<uint64_t>();
 }
 
-double Options::number(const std::string& key, double def) {
+double Options::number(const std::string& key, double def, double lo, double hi, bool lo_open) {
   py::object o = take(key);
   if (o.is_none()) return def;
+  const std::string range = range_num(lo, hi, lo_open);
   if (py::isinstance<py::bool_>(o) || !(PyFloat_Check(o.ptr()) || PyIndex_Check(o.ptr()) ||
                                         py::hasattr(o, "__float__")))
-    type_error(key, "a number", o);
+    type_error(key, "a number" + range, o);
   const double v = py::float_(o).cast<double>();
-  if (!std::isfinite(v)) fail(key + ": expected a finite number, found " + std::string(py::str(o)));
+  if (!std::isfinite(v) && range.empty()) fail(key + ": expected a finite number, found " + std::string(py::str(o)));
+  if (!std::isfinite(v) || (lo_open ? v <= lo : v < lo) || v > hi)
+    fail(key + ": expected a number" + range + ", found " + fmt_num(v));
   return v;
 }
 

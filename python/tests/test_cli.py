@@ -169,3 +169,35 @@ def test_defines_and_frame(runs, tmp_path):
             bf.results(cli_out, frame=True)
     else:
         assert len(bf.results(cli_out, frame=True)) == 8
+
+
+# (kind, TOML lines of its [[method]] table, the same as keyword options)
+BAD_OPTIONS = [
+    ("mccool", "smoothing = -1.0", dict(smoothing=-1.0)),
+    ("mccool", "solve_last = 0", dict(solve_last=0)),
+    ("mccool", "refine_iterations = 0", dict(refine_iterations=0)),
+    ("fit", 'projections = [{ name = "wi" }]\nterms = 2', dict(projections=["wi"], terms=2)),
+    ("search", "restarts = -2", dict(restarts=-2)),
+    ("search", "restarts = 2\nbeam = 9", dict(restarts=2, beam=9)),
+    ("search", "ftol = 0.0", dict(ftol=0.0)),
+    ("search", "search_texture_size = 1", dict(search_texture_size=1)),
+    ("svd", "rim_inset = 0.7", dict(rim_inset=0.7)),
+    ("sh-k", "order = 300", dict(order=300)),
+    ("sh-r", "energy_eps = 2.0", dict(energy_eps=2.0)),
+    ("model-fit", "lobes = 5", dict(lobes=5)),
+]
+
+
+@pytest.mark.parametrize("kind,toml,options", BAD_OPTIONS, ids=[b[1].split("\n")[-1] for b in BAD_OPTIONS])
+def test_option_errors_state_the_cli_rule(tmp_path, cli, grid8, bluepaint, kind, toml, options):
+    cfg = tmp_path / "bad.toml"
+    cfg.write_text('[[brdf]]\npreset = "bluepaint"\n[sampling]\nkind = "grid"\nresolution = 8\n'
+                   '[[method]]\nkind = "%s"\n%s\n' % (kind, toml))
+    r = subprocess.run([cli, "run", str(cfg), "--dry-run", "--quiet"], capture_output=True, text=True)
+    assert r.returncode == 2
+    # "brdf-factor: FILE:LINE: method[0].KEY: RULE" or "...: method[0]: KEY: RULE" -> "KEY: RULE"
+    cli_rule = r.stderr.strip().split("method[0]", 1)[1].lstrip(".: ")
+    assert ": " in cli_rule, r.stderr
+    with pytest.raises(ValueError) as e:
+        bf.factor(kind, brdf=bluepaint, samples=grid8, **options)
+    assert str(e.value) == kind + ": " + cli_rule
