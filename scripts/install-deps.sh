@@ -22,6 +22,10 @@ PACKAGES=(
   libcli11-dev           # command-line parsing
   glslang-tools          # compiles the generated GLSL in a test
   python3-matplotlib     # plots in experiment reports
+  pybind11-dev           # the Python module (python/), built for /usr/bin/python3
+  python3-dev            # Python headers and libpython for the module
+  python3-numpy          # arrays in and out of the Python module
+  python3-pytest         # the Python module's tests (python/tests/)
 )
 case "${1:-}" in
   "") ;;

@@ -1,0 +1,151 @@
+"""brdf-factor from Python: the catalogue, sample sets, every factorization
+method, and experiment configs, with numpy arrays in and out.
+
+    import brdf_factor as bf
+    b = bf.brdf("bluepaint")
+    s = bf.sample_grid(b, 16)
+    f = bf.search(s, terms=2, restarts=4)
+    f.metrics["rel_mse"], f.eval(wi, wo)        # wi, wo: (N, 3) -> (N, 3)
+
+Errors raise ValueError (bad input; ConfigError for configs) or RuntimeError
+with the same text the CLI prints after "brdf-factor: ". See docs/python.md.
+"""
+
+import csv as _csv
+import os as _os
+
+from ._core import (  # noqa: F401  (the public API)
+    Brdf,
+    ConfigError,
+    Factorization,
+    SampleSet,
+    __version__,
+    brdf,
+    data_dir,
+    evaluate,
+    file_formats,
+    fit,
+    load,
+    mccool,
+    measured_samples,
+    model_fit,
+    models,
+    presets,
+    read_samples,
+    refine,
+    run_experiment as _run_experiment,
+    sample_grid,
+    sample_stratified,
+    score,
+    search,
+    sh_k,
+    sh_r,
+    svd,
+)
+
+__all__ = [
+    "Brdf", "ConfigError", "Factorization", "SampleSet", "brdf", "data_dir", "evaluate",
+    "factor", "file_formats", "fit", "load", "mccool", "measured_samples", "model_fit",
+    "models", "presets", "read_samples", "refine", "results", "run", "sample_grid",
+    "sample_stratified", "score", "search", "sh_k", "sh_r", "svd", "METHODS",
+]
+
+# Method kinds as the configs name them -> the function and what it factors
+# ("samples": fitted to a sample set; "brdf": tabulates the BRDF itself).
+METHODS = {
+    "mccool": (mccool, "samples"),
+    "fit": (fit, "samples"),
+    "search": (search, "samples"),
+    "svd": (svd, "brdf"),
+    "sh-k": (sh_k, "brdf"),
+    "sh-r": (sh_r, "brdf"),
+    "model-fit": (model_fit, "samples"),
+}
+
+
+def factor(kind, brdf=None, samples=None, **options):
+    """Runs method `kind` ("mccool", "fit", "search", "svd", "sh-k", "sh-r",
+    "model-fit") as a config's [[method]] with these options would.
+
+    Sample-based kinds need `samples` (or a `brdf`, sampled on the 16^4 grid,
+    the config's default sampling); tabulating kinds need `brdf` and report
+    metrics when `samples` are given (or sampled from the brdf likewise)."""
+    if kind not in METHODS:
+        raise ValueError("kind: expected one of %s, found %r" % (", ".join(METHODS), kind))
+    fn, needs = METHODS[kind]
+    if samples is None and brdf is not None:
+        samples = sample_grid(brdf, 16)
+    if needs == "samples":
+        if samples is None:
+            raise ValueError("%s: needs samples (or a brdf to sample)" % kind)
+        return fn(samples, **options)
+    if brdf is None:
+        raise ValueError("%s: needs a brdf (it tabulates the BRDF itself)" % kind)
+    return fn(brdf, samples, **options)
+
+
+def _defines(defines):
+    if defines is None:
+        return []
+    if isinstance(defines, dict):
+        out = []
+        for k, v in defines.items():
+            if isinstance(v, bool):
+                v = "true" if v else "false"
+            elif isinstance(v, str):
+                v = '"%s"' % v if not v.startswith(("[", "{", '"')) else v
+            out.append("%s=%s" % (k, v))
+        return out
+    return list(defines)
+
+
+class Run(dict):
+    """What run() returns: the run summary (out_dir, planned, executed, cached,
+    failed, run_ids, files, output) as a dict, plus the results table."""
+
+    def results(self, frame=False):
+        return results(self["out_dir"], frame=frame)
+
+
+def run(config, defines=None, out=None, dry_run=False, force=False, quiet=True,
+        shard="1/1", jobs=-1, plots=False):
+    """Runs an experiment config as `brdf-factor run CONFIG` does (same run
+    cache, outputs and messages). defines: "key=value" strings (-D) or a dict
+    (strings are quoted for TOML). plots=False skips plot_results.py (the
+    CLI's --no-plots); quiet=True keeps progress off stderr. Returns a Run
+    (a dict; .results() reads results.csv). Config errors raise ConfigError
+    with the CLI's text; a failed run raises RuntimeError after the outputs
+    are written."""
+    s = _run_experiment(_os.fspath(config), _defines(defines), "" if out is None else _os.fspath(out),
+                        dry_run, force, quiet, shard, jobs, plots)
+    return Run(s)
+
+
+def _value(text):
+    if text == "":
+        return None
+    if text in ("true", "false"):
+        return text == "true"
+    try:
+        return int(text)
+    except ValueError:
+        pass
+    try:
+        return float(text)
+    except ValueError:
+        return text
+
+
+def results(path, frame=False):
+    """An experiment folder's results.csv (or the file itself) as a list of
+    dicts, one per run, numbers as int/float, empty cells as None; with
+    frame=True a pandas DataFrame (pandas must be installed)."""
+    path = _os.fspath(path)
+    if _os.path.isdir(path):
+        path = _os.path.join(path, "results.csv")
+    with open(path, newline="") as f:
+        rows = [{k: _value(v) for k, v in row.items()} for row in _csv.DictReader(f)]
+    if frame:
+        import pandas  # noqa: raises ImportError naming pandas when it is missing
+        return pandas.DataFrame(rows)
+    return rows

@@ -1,0 +1,177 @@
+// Factorization objects in Python: evaluation (inherited from Brdf), metrics,
+// texture arrays, exports (EXR/PNG/JSON/GLSL, model-fit JSON, MERL) and reload.
+#include <filesystem>
+#include <fstream>
+
+#include "brdfs/merl.h"
+#include "common.h"
+#include "factor/export.h"
+#include "factor/homomorphic.h"
+#include "factor/model_fit.h"
+
+namespace bf::py_module {
+
+namespace {
+
+std::shared_ptr<const HomomorphicFactorization> homomorphic(const PyFactorization& f) {
+  return std::dynamic_pointer_cast<const HomomorphicFactorization>(f.f);
+}
+
+py::dict exported_dict(const ExportedFiles& e) {
+  py::dict d;
+  d["sidecar"] = e.sidecar;
+  d["glsl"] = e.glsl;
+  d["textures"] = e.textures;
+  d["previews"] = e.previews;
+  return d;
+}
+
+}  // namespace
+
+std::shared_ptr<PyFactorization> wrap(FactorizationPtr f) {
+  auto p = std::make_shared<PyFactorization>();
+  p->brdf = f;
+  p->f = std::move(f);
+  return p;
+}
+
+void bind_factorization(py::module_& m) {
+  py::class_<PyFactorization, PyBrdf, std::shared_ptr<PyFactorization>>(m, "Factorization", R"doc(
+What a method returns: an approximation that evaluates like any Brdf
+(eval/__call__ on (N, 3) arrays), with the method's report (metrics on the
+fitted samples, errors after each term, time, evaluations), its description,
+and exports.)doc")
+      .def_property_readonly("method", [](const PyFactorization& f) { return f.f->method(); },
+                             "\"mccool\", \"fit\", \"search\", \"svd\", \"sh-k\", \"sh-r\", \"model-fit\" (+\"+refine-<objective>\")")
+      .def_property_readonly("storage_floats", [](const PyFactorization& f) { return f.f->storage_floats(); },
+                             "floats a renderer must store")
+      .def_property_readonly(
+          "metrics", [](const PyFactorization& f) -> py::object { return f.metrics ? py::object(metrics_dict(*f.metrics)) : py::none(); },
+          "dict rel_mse, rel_mae, rel_max, lin_rmse, lin_mae, lin_max, cos_rmse, samples on the samples it was fitted "
+          "to (scored with metric_eps), or None (tabulating method without samples, reloaded export)")
+      .def_readonly("metric_eps", &PyFactorization::metric_eps)
+      .def_readonly("errors_after_term", &PyFactorization::errors_after_term,
+                    "homomorphic methods: rel_mse on the fit data after each term")
+      .def_readonly("seconds", &PyFactorization::seconds, "wall time of the method")
+      .def_readonly("evaluations", &PyFactorization::evaluations, "search: inner-loop fits; model-fit: LM iterations")
+      .def_property_readonly("info", [](const PyFactorization& f) { return to_python(f.info); },
+                             "method-specific record (search terms, refinement report, model-fit parameters, ...)")
+      .def("describe", [](const PyFactorization& f) { return to_python(f.f->describe()); },
+           "Everything needed to rebuild it, as in the export sidecar (dict).")
+      .def(
+          "score",
+          [](const PyFactorization& f, const SampleSet& s, double eps) {
+            py::gil_scoped_release release;
+            const Metrics mt = evaluate_metrics(*f.f, s, LogTransform::of(s, eps));
+            py::gil_scoped_acquire gil;
+            return metrics_dict(mt);
+          },
+          py::arg("samples"), py::arg("metric_eps") = 1e-5,
+          "Metrics (DESIGN.md §4) of this approximation on any sample set.")
+      .def(
+          "textures",
+          [](const PyFactorization& f) {
+            auto h = homomorphic(f);
+            if (!h)
+              throw std::invalid_argument("textures: method " + f.f->method() +
+                                          " has no log textures (only mccool, fit and search factorizations)");
+            py::list out;
+            for (const auto& t : h->terms()) {
+              const int r = t.proj.res;
+              py::array_t<float> a({r, r, 3});
+              auto v = a.mutable_unchecked<3>();
+              for (int j = 0; j < r; ++j)
+                for (int i = 0; i < r; ++i)
+                  for (int c = 0; c < 3; ++c) v(j, i, c) = t.texels[c][j * r + i];
+              out.append(a);
+            }
+            return out;
+          },
+          "Homomorphic factorizations: each term's log-space texels as a (res, res, 3) float32 array, "
+          "[j, i] = texel (i, j) (what the EXR holds; 0 outside the mask).")
+      .def_property_readonly("A", [](const PyFactorization& f) -> py::object {
+        auto h = homomorphic(f);
+        if (!h) return py::none();
+        return py::make_tuple(h->A()[0], h->A()[1], h->A()[2]);
+      }, "homomorphic: the per-channel scale A, else None")
+      .def(
+          "export",
+          [](const PyFactorization& f, const std::string& dir, const std::string& stem) -> py::dict {
+            if (auto h = homomorphic(f)) {
+              py::gil_scoped_release release;
+              const ExportedFiles e = write_factorization(*h, dir, stem);
+              py::gil_scoped_acquire gil;
+              return exported_dict(e);
+            }
+            if (auto mf = std::dynamic_pointer_cast<const ModelFitFactorization>(f.f)) {
+              const std::string path = dir + "/" + stem + ".json";
+              std::filesystem::create_directories(dir);
+              write_model_fit(mf->result(), path);
+              py::dict d;
+              d["sidecar"] = path;
+              return d;
+            }
+            throw std::invalid_argument("export: method " + f.f->method() +
+                                        " has no texture export (EXR/PNG/JSON/GLSL are written for mccool, fit and "
+                                        "search, a JSON for model-fit); export_merl() tabulates any factorization");
+          },
+          py::arg("dir"), py::arg("stem") = "factors",
+          R"doc(Writes the export into dir: homomorphic methods STEM_termK.exr/.png,
+STEM.json (sidecar), STEM.glsl; model-fit STEM.json. Returns the paths (dict).
+load(sidecar) reads it back (bit-identical evaluation).)doc")
+      .def(
+          "export_merl",
+          [](const PyFactorization& f, const std::string& path) {
+            py::gil_scoped_release release;
+            MerlTabulateStats st;
+            write_merl(merl_tabulate(*f.f, &st), path);
+          },
+          py::arg("path"), "Tabulates it as a MERL .binary table (90x90x180, float64 RGB), as `brdf-factor export-merl`.")
+      .def("__repr__", [](const PyFactorization& f) {
+        std::string r = "<brdf_factor.Factorization " + f.f->method() + ", " + std::to_string(f.f->storage_floats()) +
+                        " floats";
+        if (f.metrics) r += ", rel_mse " + std::to_string(f.metrics->rel_mse);
+        return r + ">";
+      });
+
+  m.def(
+      "score",
+      [](const PyBrdf& approx, const SampleSet& s, double eps) {
+        py::gil_scoped_release release;
+        const Metrics mt = evaluate_metrics(*approx.brdf, s, LogTransform::of(s, eps));
+        py::gil_scoped_acquire gil;
+        return metrics_dict(mt);
+      },
+      py::arg("approx"), py::arg("samples"), py::arg("metric_eps") = 1e-5,
+      "Metrics (DESIGN.md §4) of any BRDF (a factorization, a model, a reloaded export) on a sample set.");
+  m.def(
+      "load",
+      [](const std::string& path) -> py::object {
+        std::string format;
+        {
+          std::ifstream in(path);
+          if (!in) throw std::invalid_argument(path + ": cannot open");
+          try {
+            format = nlohmann::json::parse(in).value("format", "");
+          } catch (const nlohmann::json::exception& e) {
+            throw std::invalid_argument(path + ": not a JSON file (" + e.what() + ")");
+          }
+        }
+        if (format == kModelFitFormat) {
+          auto b = std::make_shared<PyBrdf>();
+          b->brdf = load_model_fit(path);
+          return py::cast(b);
+        }
+        std::shared_ptr<const HomomorphicFactorization> h;
+        {
+          py::gil_scoped_release release;
+          h = load_factorization(path);
+        }
+        return py::cast(wrap(h));
+      },
+      py::arg("path"),
+      R"doc(Reads an export back: a factorization sidecar (STEM.json of mccool, fit,
+search) as a Factorization (metrics None), a model-fit JSON as a Brdf.)doc");
+}
+
+}  // namespace bf::py_module
