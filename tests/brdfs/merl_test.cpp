@@ -175,7 +175,7 @@ TEST_CASE("merl: write then read reproduces an analytic BRDF at bin centres") {
   }
 }
 
-TEST_CASE("merl: nearest lookup matches the reference indexing; linear is trilinear") {
+TEST_CASE("merl: nearest lookup matches the reference indexing and linear is trilinear") {
   // A table whose value is a known linear function of the three bin indices.
   auto t = std::make_shared<MerlTable>();
   t->raw.resize(3 * kMerlCells);
