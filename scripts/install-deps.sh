@@ -22,6 +22,8 @@ PACKAGES=(
   libcli11-dev           # command-line parsing
   glslang-tools          # compiles the generated GLSL in a test
   python3-matplotlib     # plots in experiment reports
+  git                    # the build's commit in run records (a runner test needs it)
+  util-linux             # unshare: a test mounts a folder read-only (CI runs as root)
 )
 case "${1:-}" in
   "") ;;
