@@ -36,12 +36,37 @@ TEST_CASE("fit: a planted product-separable BRDF is recovered with its own proje
   const auto f = std::make_shared<HomomorphicFactorization>(sol.terms, d.transform.A, opt.eps,
                                                             true, "fit");
   const Metrics m = evaluate_metrics(*f, s, d.transform);
-  INFO("rel_mse at texture 32 = " << m.rel_mse);
-  CHECK(m.rel_mse < 1e-4);
-  // The three textures reproduce the factors up to constants: compare the
-  // recovered log texture of a(wi) at two points against log a difference.
   const SampleSet held = sample_stratified(brdf, 5000, 99);
-  CHECK(evaluate_metrics(*f, held, d.transform).rel_mse < 1e-4);
+  const double held_mse = evaluate_metrics(*f, held, d.transform).rel_mse;
+  // Each texture reproduces its own factor up to a constant: the recovered log
+  // texture's difference between a disk point u and the centre equals
+  // log a(u) - log a(0) (a, b, c of PlantedBrdf), every channel.
+  const auto tex_at = [&](size_t k, const Vec2& u) {
+    const Vec4 x = k == 1 ? Vec4(0, 0, u.x(), u.y()) : Vec4(u.x(), u.y(), 0, 0);
+    return sol.terms[k].proj.texel_coords(x);
+  };
+  const std::array<std::array<double, 4>, 3> coef = {
+      {{0.4, -0.3, 0.5, 0.2}, {-0.2, 0.5, -0.4, 0.3}, {0.3, 0.2, -0.8, -0.5}}};
+  std::mt19937_64 rng(8);
+  std::uniform_real_distribution<double> U(-0.75, 0.75);
+  double factor_err = 0.0;
+  for (size_t k = 0; k < 3; ++k)
+    for (int trial = 0; trial < 20; ++trial) {
+      const Vec2 u(U(rng), U(rng));
+      const auto& c = coef[k];
+      const double want = std::log(bf_test::smooth_factor(u, c[0], c[1], c[2], c[3]));
+      for (int ch = 0; ch < 3; ++ch) {
+        const double got = sol.terms[k].lookup(ch, tex_at(k, u)) - sol.terms[k].lookup(ch, tex_at(k, Vec2(0, 0)));
+        factor_err = std::max(factor_err, std::abs(got - want));
+      }
+    }
+  INFO("rel_mse at texture 32 = " << m.rel_mse << " (fit samples), " << held_mse
+                                  << " (held out); max |log factor error| " << factor_err);
+  // Bounds 3x the measured values (rel_mse 9.5e-8 fit, 1.1e-7 held out; max
+  // log factor error 9.1e-4 over 20 points per factor).
+  CHECK(m.rel_mse < 3e-7);
+  CHECK(held_mse < 3.5e-7);
+  CHECK(factor_err < 2.7e-3);
 }
 
 TEST_CASE("fit: RMS log error falls about 4x per doubling of texture resolution") {
@@ -156,10 +181,34 @@ TEST_CASE("fit: the schedule solves the last n terms jointly and error never inc
   opt.solve_last = 2;
   const FitData d(s, opt.eps);
   std::vector<double> errs;
-  fit_homomorphic(d, planted_terms(12), opt, "fit", &errs);
+  const std::vector<TermSpec> terms = planted_terms(12);
+  const auto f = fit_homomorphic(d, terms, opt, "fit", &errs);
   REQUIRE(errs.size() == 3);
   CHECK(errs[1] <= errs[0] * (1 + 1e-9));
   CHECK(errs[2] <= errs[1] * (1 + 1e-9));
+  // The schedule done by hand with solve_joint: {t0}, then {t0, t1} jointly,
+  // then {t1, t2} jointly with step 2's t0 held.
+  std::array<std::vector<double>, 3> zero;
+  for (auto& z : zero) z.assign(d.size(), 0.0);
+  const JointSolution s1 = solve_joint(d, zero, {terms[0]}, opt);
+  const JointSolution s2 = solve_joint(d, zero, {terms[0], terms[1]}, opt);
+  const JointSolution s3 = solve_joint(d, fixed_sum(d, {s2.terms[0]}), {terms[1], terms[2]}, opt);
+  CHECK(errs[0] == Approx(s1.rel_mse).epsilon(1e-9));
+  CHECK(errs[1] == Approx(s2.rel_mse).epsilon(1e-9));
+  CHECK(errs[2] == Approx(s3.rel_mse).epsilon(1e-9));
+  // solve_last = 1 (greedy, one term at a time) is a different schedule: its
+  // later errors are higher (measured 0.0122 vs 0.0104 after term 2, 0.0050
+  // vs 0.0025 after term 3), so a fit that ignored solve_last fails here.
+  FitOptions greedy = opt;
+  greedy.solve_last = 1;
+  std::vector<double> gerrs;
+  fit_homomorphic(d, terms, greedy, "fit", &gerrs);
+  REQUIRE(gerrs.size() == 3);
+  INFO("solve_last 2: " << errs[0] << " " << errs[1] << " " << errs[2] << "; solve_last 1: " << gerrs[0] << " "
+                        << gerrs[1] << " " << gerrs[2]);
+  CHECK(gerrs[0] == Approx(errs[0]).epsilon(1e-9));
+  CHECK(gerrs[1] > errs[1] * 1.1);
+  CHECK(gerrs[2] > errs[2] * 1.5);
 }
 
 TEST_CASE("fit: degenerate input gives a clear error or a finite answer") {
