@@ -21,6 +21,8 @@ PACKAGES=(
   nlohmann-json3-dev     # JSON sidecars and manifests
   libcli11-dev           # command-line parsing
   glslang-tools          # compiles the generated GLSL in a test
+  libegl-dev libgl-dev libopengl-dev  # EGL/OpenGL headers for the GLSL test helper
+  libegl-mesa0 libgl1-mesa-dri        # Mesa's surfaceless EGL and llvmpipe: the generated GLSL runs on the CPU
   python3-matplotlib     # plots in experiment reports
   git                    # the build's commit in run records (a runner test needs it)
   util-linux             # unshare: a test mounts a folder read-only (CI runs as root)
