@@ -39,7 +39,7 @@ for m in "${mutations[@]}"; do
   if ! cmake --build build -j "$(nproc)" > "$log_dir/$name.build.log" 2>&1; then
     echo "   build FAILED (see $log_dir/$name.build.log)"; git checkout -- "$file"; exit 2
   fi
-  (cd build && ctest -LE slow --no-tests=error -j "$(nproc)" --timeout 600) > "$log_dir/$name.ctest.log" 2>&1 || true
+  (cd build && ctest -LE slow --no-tests=error --output-on-failure -j "$(nproc)" --timeout 600) > "$log_dir/$name.ctest.log" 2>&1 || true
   git checkout -- "$file"
   failed=$(sed -n 's/^[[:space:]]*[0-9]* - \(.*\) (\(Failed\|Timeout\|SEGFAULT\|Subprocess aborted\|Exception\)).*$/\1/p' "$log_dir/$name.ctest.log")
   summary=$(grep -E 'tests passed, [0-9]+ tests failed' "$log_dir/$name.ctest.log" || echo "no ctest summary")
