@@ -21,11 +21,15 @@ PACKAGES=(
   nlohmann-json3-dev     # JSON sidecars and manifests
   libcli11-dev           # command-line parsing
   glslang-tools          # compiles the generated GLSL in a test
+  libegl-dev libgl-dev libopengl-dev  # EGL/OpenGL headers for the GLSL test helper
+  libegl-mesa0 libgl1-mesa-dri        # Mesa's surfaceless EGL and llvmpipe: the generated GLSL runs on the CPU
   python3-matplotlib     # plots in experiment reports
   pybind11-dev           # the Python module (python/), built for /usr/bin/python3
   python3-dev            # Python headers and libpython for the module
   python3-numpy          # arrays in and out of the Python module
   python3-pytest         # the Python module's tests (python/tests/)
+  git                    # the build's commit in run records (a runner test needs it)
+  util-linux             # unshare: a test mounts a folder read-only (CI runs as root)
 )
 case "${1:-}" in
   "") ;;

@@ -26,6 +26,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
+using bf_test::slurp;
 using bf_test::TempDir;
 
 const auto run_cli = bf_test::run_cli_stderr;
@@ -175,7 +176,7 @@ TEST_CASE("merl: write then read reproduces an analytic BRDF at bin centres") {
   }
 }
 
-TEST_CASE("merl: nearest lookup matches the reference indexing; linear is trilinear") {
+TEST_CASE("merl: nearest lookup matches the reference indexing and linear is trilinear") {
   // A table whose value is a known linear function of the three bin indices.
   auto t = std::make_shared<MerlTable>();
   t->raw.resize(3 * kMerlCells);
@@ -369,11 +370,21 @@ TEST_CASE("cli: export-merl writes a readable 34,992,012-byte file, atomically")
   CHECK(run_cli("export-merl --brdf nope --out " + missing, &err) == 2);
   CHECK_THAT(err, Contains("brdf-factor: --brdf: unknown BRDF 'nope'"));
   CHECK_FALSE(fs::exists(missing));
+  // Every MERL file has the same size: compare the bytes, not the size.
+  const std::string before = slurp(out);
+  REQUIRE(before.size() == kMerlFileBytes);
   CHECK(run_cli("export-merl --brdf " + std::string(BF_TEST_DATA_DIR) +
                     "/measured/astm_degrees.astm --out " + out,
                 &err) == 2);
   CHECK_THAT(err, Contains("(degrees?"));
-  CHECK(fs::file_size(out) == kMerlFileBytes);
+  CHECK(slurp(out) == before);
+  // A successful export of another BRDF does change the bytes (the comparison
+  // can fail), through a rename that leaves no temporary behind.
+  REQUIRE(run_cli("export-merl --brdf lambert:kd=0.5 --out " + out, &err) == 0);
+  CHECK(slurp(out) != before);
+  size_t entries = 0;
+  for ([[maybe_unused]] const auto& e : fs::directory_iterator(d.path)) ++entries;
+  CHECK(entries == 1);  // no temporary left beside it
   CHECK(run_cli("export-merl --brdf lambert --out " + d.file("no/such/dir/x.binary"), &err) == 2);
   CHECK_THAT(err, Contains("cannot open"));
 }

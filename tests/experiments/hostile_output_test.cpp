@@ -160,19 +160,34 @@ TEST_CASE("nothing lost: an output folder that cannot be created or written fail
                        Catch::Contains("Not a directory"));
   CHECK_THAT(text, !Catch::Contains("start 1/"));
 
-  // Read-only folder: root writes anyway, so only an unprivileged user can see it.
+  // Read-only folder. chmod 555 blocks an unprivileged user; root (CI runs as
+  // root) writes anyway, so as root the CLI runs in a private mount namespace
+  // where the folder is bind-mounted read-only (util-linux unshare, needs
+  // CAP_SYS_ADMIN): a failure to set that up fails the test, never skips it.
   const fs::path ro = tmp.path / "readonly";
   fs::create_directories(ro);
   ::chmod(ro.c_str(), 0555);
-  const bool blocks = ::access(ro.c_str(), W_OK) != 0;
-  if (!blocks) {
-    WARN("running as root (euid " << ::geteuid() << "): chmod 555 does not block writes; read-only case skipped");
-  } else {
-    CHECK(run_cli("run " + cfg + " --out " + (ro / "out").string() + " --no-plots", &text) == 2);
-    CHECK_THAT(text, Catch::Contains((ro / "out").string() + ": cannot create the output folder"));
-    CHECK(run_cli("run " + cfg + " --out " + ro.string() + " --no-plots", &text) == 2);
-    CHECK_THAT(text, Catch::Contains(ro.string() + ": the output folder is not writable"));
-  }
+  const bool chmod_blocks = ::access(ro.c_str(), W_OK) != 0;
+  auto run_readonly = [&](const std::string& args, std::string* out) {
+    if (chmod_blocks) return run_cli(args, out);
+    const std::string cmd = "unshare -m sh -c 'mount --bind -o ro " + ro.string() + " " + ro.string() +
+                            " && exec " + std::string(BF_CLI_PATH) + " " + args + "' 2>&1";
+    FILE* p = popen(cmd.c_str(), "r");
+    std::string o;
+    char buf[4096];
+    size_t n;
+    while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) o.append(buf, n);
+    const int st = pclose(p);
+    *out = o;
+    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+  };
+  INFO((chmod_blocks ? "chmod 555" : "read-only bind mount (euid 0)"));
+  CHECK(run_readonly("run " + cfg + " --out " + (ro / "out").string() + " --no-plots", &text) == 2);
+  CHECK_THAT(text, Catch::Contains((ro / "out").string() + ": cannot create the output folder"));
+  CHECK(run_readonly("run " + cfg + " --out " + ro.string() + " --no-plots", &text) == 2);
+  CHECK_THAT(text, Catch::Contains(ro.string() + ": the output folder is not writable"));
+  CHECK_THAT(text, !Catch::Contains("start 1/"));
+  CHECK(fs::is_empty(ro));
   ::chmod(ro.c_str(), 0755);
 }
 

@@ -99,7 +99,7 @@ TEST_CASE("config: bad refine and model-fit settings name the field") {
               {"method[0].texture_size:", "does not apply to kind = \"model-fit\""});
 }
 
-TEST_CASE("runner: a refined row reports the fit before and after; the export is the refined one") {
+TEST_CASE("runner: a refined row reports the fit before and after and the export is the refined one") {
   // The linear objective without smoothing minimizes lin_rmse (unclamped;
   // the clamp only lowers it) from the log fit: it cannot end higher, and on
   // this grid it ends far lower.

@@ -332,7 +332,7 @@ TEST_CASE("model-fit: anisotropic Ward and Ashikhmin-Shirley recover both roughn
   REQUIRE_THROWS_WITH(check_model_fit(bad), Contains("anisotropic") && Contains("cook-torrance"));
 }
 
-TEST_CASE("model-fit: the written file loads back as the fitted BRDF; bad files are refused") {
+TEST_CASE("model-fit: the written file loads back as the fitted BRDF and bad files are refused") {
   const BrdfPtr b = Catalogue::builtin().make("ward:kd=0.1/0.2/0.3,ks=0.3/0.2/0.1,ax=0.2,ay=0.2");
   const SampleSet s = sample_grid(*b, 5);
   ModelFitOptions opt;

@@ -103,11 +103,33 @@ TEST_CASE("size selection: svd picks the smallest resolution, then the smallest 
   REQUIRE(f);
   CHECK(f->options().res == ex.res);
   CHECK(f->rank() == ex.value);
-  // The next smaller resolution reaches with no rank up to the cap; the next
-  // smaller rank at the chosen resolution does not either.
-  const size_t i = std::find(ladder.begin(), ladder.end(), ex.res) - ladder.begin();
+  // The selector's own choice, checked against the brute-force table: the
+  // next smaller resolution reaches with no rank up to the cap, the next
+  // smaller rank at the chosen resolution does not either, and every
+  // (resolution, rank) it scored has the brute-force error.
+  const size_t i = std::find(ladder.begin(), ladder.end(), ch.texture_size) - ladder.begin();
+  REQUIRE(i > 0);
+  REQUIRE(i < ladder.size());
   CHECK(best_at(err, ladder[i - 1]) > tol);
-  if (ex.value > 1) CHECK(err.at({ex.res, ex.value - 1}) > tol);
+  if (ch.value > 1) CHECK(err.at({ch.texture_size, ch.value - 1}) > tol);
+  for (const auto& t : ch.tried) {
+    INFO("tried res " << t.texture_size << " rank " << t.value);
+    CHECK(t.error == Approx(err.at({t.texture_size, t.value})).epsilon(1e-9));
+  }
+  // The choice above is rank 1 (measured); a tolerance that no rank-1 fit
+  // reaches at any resolution makes the rank matter: the choice has rank >= 2,
+  // rank - 1 at its resolution does not reach, nor does any smaller resolution.
+  double best1 = std::numeric_limits<double>::infinity();
+  for (int res : ladder) best1 = std::min(best1, err.at({res, 1}));
+  REQUIRE(err.at({ladder.back(), 2}) < best1);
+  const double tol2 = std::sqrt(best1 * err.at({ladder.back(), 2}));
+  const SizeChoice ch2 = select_svd_size(brdf, s, opt, {"rel_mse", tol2}, cap, ladder);
+  CHECK(ch2.reached);
+  REQUIRE(ch2.value >= 2);
+  CHECK(err.at({ch2.texture_size, ch2.value - 1}) > tol2);
+  CHECK(ch2.error == Approx(err.at({ch2.texture_size, ch2.value})).epsilon(1e-9));
+  for (int res : ladder)
+    if (res < ch2.texture_size) CHECK(best_at(err, res) > tol2);
   // tried lists every (resolution, rank) scored, in order, up to the choice.
   REQUIRE(!ch.tried.empty());
   CHECK(ch.tried.front().texture_size == ladder.front());
@@ -160,9 +182,17 @@ TEST_CASE("size selection: homomorphic terms and resolution (McCool's projection
   CHECK(ch.texture_size == ex.res);
   CHECK(ch.value == ex.value);
   CHECK(ch.error == Approx(err.at({ex.res, ex.value})).epsilon(1e-9));
-  const size_t i = std::find(ladder.begin(), ladder.end(), ex.res) - ladder.begin();
+  // The selector's own choice against the brute-force table (as above).
+  const size_t i = std::find(ladder.begin(), ladder.end(), ch.texture_size) - ladder.begin();
+  REQUIRE(i > 0);
+  REQUIRE(i < ladder.size());
   CHECK(best_at(err, ladder[i - 1]) > tol);
-  if (ex.value > 1) CHECK(err.at({ex.res, 1}) > tol);
+  REQUIRE(ch.value == 2);  // measured: the second term (q(h)) is needed
+  CHECK(err.at({ch.texture_size, 1}) > tol);
+  for (const auto& t : ch.tried) {
+    INFO("tried res " << t.texture_size << " terms " << t.value);
+    CHECK(t.error == Approx(err.at({t.texture_size, t.value})).epsilon(1e-9));
+  }
   const auto* h = dynamic_cast<const HomomorphicFactorization*>(ch.result.get());
   REQUIRE(h);
   CHECK(int(h->terms().size()) == ex.value);

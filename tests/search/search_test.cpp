@@ -115,7 +115,12 @@ TEST_CASE("search: nlopt optimizers share the objective and improve on their sta
     const SearchResult res = search_factorization(d, opt);
     const TermObjective obj(d, {}, {}, opt, 6);
     INFO(name << ": " << res.terms[0].search_rel_mse << " from " << obj(Rotation4::identity()));
-    CHECK(res.terms[0].search_rel_mse <= obj(Rotation4::identity()));
+    // Every optimizer must move well below its start (an optimizer that does
+    // nothing stays at it): measured from 0.709 to 0.0028 (praxis, bobyqa,
+    // neldermead), 0.0034 (sbplx), 0.0058 (direct), 0.081 (crs, the worst, 8.8x
+    // lower); the bound asks for 4x lower.
+    CHECK(res.terms[0].search_rel_mse < 0.25 * obj(Rotation4::identity()));
+    CHECK(res.terms[0].evaluations >= 10);
     CHECK(res.terms[0].evaluations <= 160);
   }
 }
