@@ -22,6 +22,7 @@
 #include "experiments/cli_util.h"
 #include "experiments/render.h"
 #include "experiments/preflight.h"
+#include "factor/baseline_export.h"
 #include "factor/export.h"
 #include "factor/isotropy.h"
 #include "factor/lighting.h"
@@ -514,6 +515,8 @@ RunEntry execute_run(const Plan& plan, const PlannedRun& pr, const SampleSet& sa
     else {
       const json d = f->describe();
       write_file_atomic((run_dir / "factorization.json").string(), [&](std::ostream& o) { o << d.dump(2) << "\n"; });
+      // svd, sh-k, sh-r: the loadable export (factor/baseline_export.h).
+      if (is_baseline_method(f->method())) write_baseline_export(*f, run_dir.string(), "factors");
     }
   }
   if (plan.experiment.render) {
