@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "experiments/cli_util.h"
+#include "experiments/viewer.h"
 
 namespace bf {
 
@@ -53,7 +54,10 @@ td.best,span.best{font-weight:bold;background:#dff3df}.tablewrap{overflow-x:auto
 .plots img{max-width:45%;margin:0.5em;border:1px solid #ddd}
 .run{border:1px solid #ddd;border-radius:6px;padding:0.6em 1em;margin:1em 0}
 .run img.sphere{max-width:100%;image-rendering:pixelated}.run img.tex{height:96px;margin-right:4px;image-rendering:pixelated}
-.files a{margin-right:0.8em;font-size:0.85em}code{background:#f6f6f6;padding:0 3px}
+.files a{margin-right:0.8em;font-size:0.85em}
+.vrow{display:flex;flex-wrap:wrap;gap:1em;align-items:flex-start}.vrow figure{margin:0}
+#viewer canvas#v-orig,#viewer canvas#v-approx,#viewer canvas#v-diff{width:256px;height:256px;cursor:crosshair}
+#viewer canvas#v-slice-orig,#viewer canvas#v-slice-approx{width:180px;height:180px;image-rendering:pixelated}code{background:#f6f6f6;padding:0 3px}
 pre{background:#f6f6f6;padding:0.8em;overflow:auto;font-size:0.85em}
 )";
 
@@ -179,6 +183,15 @@ void write_report_html(const ExperimentOutput& e, const OutputFiles& f, const st
         else h << "<a href=\"" << url(p) << "\">" << esc(p) << "</a> ";
       }
     h << "</div>\n";
+  }
+
+  // The WebGL2 viewer (experiments/viewer.h), when some run wrote its data.
+  {
+    std::vector<std::string> scripts;
+    for (const auto& r : e.runs)
+      if (r.status == "ok" && exists_in(dir, "runs/" + r.run_id + "/viewer.js"))
+        scripts.push_back("runs/" + r.run_id + "/viewer.js");
+    if (!scripts.empty()) h << viewer_section(scripts);
   }
 
   // Runs.

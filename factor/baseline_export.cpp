@@ -552,6 +552,24 @@ std::string generate_baseline_glsl(const Factorization& f, const std::string& st
   throw std::invalid_argument("export: method '" + f.method() + "' has no SVD/SH export");
 }
 
+std::vector<std::pair<std::string, FloatImage>> baseline_textures(const Factorization& f) {
+  std::vector<std::pair<std::string, FloatImage>> out;
+  DataBlocks d;
+  if (auto s = dynamic_cast<const SvdFactorization*>(&f)) {
+    FloatImage rows, cols;
+    svd_data(*s, d, rows, cols);
+    out.emplace_back("brdf_factor_rows", std::move(rows));
+    out.emplace_back("brdf_factor_cols", std::move(cols));
+  } else if (auto s = dynamic_cast<const ShkFactorization*>(&f)) {
+    FloatImage img;
+    shk_data(*s, d, img);
+    out.emplace_back("brdf_factor_coeffs", std::move(img));
+  } else if (!dynamic_cast<const ShrFactorization*>(&f)) {
+    throw std::invalid_argument("export: method '" + f.method() + "' has no SVD/SH export");
+  }
+  return out;
+}
+
 BaselineExportFiles write_baseline_export(const Factorization& f, const std::string& dir,
                                           const std::string& stem) {
   if (stem.empty() || stem.find('/') != std::string::npos)

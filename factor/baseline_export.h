@@ -23,6 +23,7 @@
 
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "factor/factorization.h"
@@ -47,6 +48,11 @@ BaselineExportFiles write_baseline_export(const Factorization& f, const std::str
 // The GLSL alone (what write_baseline_export writes as STEM.glsl); texture
 // file names appear in its comments.
 std::string generate_baseline_glsl(const Factorization& f, const std::string& stem);
+
+// The float32 textures of the export with their GLSL sampler names, in
+// binding order (what STEM_*.exr hold): svd rows, cols; sh-k coeffs; none for sh-r.
+struct FloatImage;
+std::vector<std::pair<std::string, FloatImage>> baseline_textures(const Factorization& f);
 
 // Reads an export back from its sidecar (the .f64 file relative to the
 // sidecar's folder). Validates format, version, method, every field read, the

@@ -22,6 +22,7 @@ PACKAGES=(
   libcli11-dev           # command-line parsing
   glslang-tools          # compiles the generated GLSL in a test
   python3-matplotlib     # plots in experiment reports
+  chromium               # headless test of report.html's WebGL2 viewer
 )
 case "${1:-}" in
   "") ;;
