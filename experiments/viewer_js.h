@@ -226,7 +226,7 @@ function put(cv, w, h, colour) {
 }
 // A horizontal colour bar with labelled ends and middle.
 function bar(cv, label, lo, hi, ramp, log) {
-  const w = 256, h = 34;
+  const w = 300, h = 44;
   cv.width = w; cv.height = h;
   const ctx = cv.getContext("2d");
   for (let x = 0; x < w; ++x) {
@@ -236,9 +236,10 @@ function bar(cv, label, lo, hi, ramp, log) {
   }
   ctx.fillStyle = "#222"; ctx.font = "11px sans-serif";
   const mid = log ? Math.sqrt(lo * hi) : 0.5 * (lo + hi);
-  ctx.textAlign = "left"; ctx.fillText(fmt(lo), 0, 27);
-  ctx.textAlign = "center"; ctx.fillText(fmt(mid) + "  " + label, w / 2, 27);
-  ctx.textAlign = "right"; ctx.fillText(fmt(hi), w, 27);
+  ctx.textAlign = "left"; ctx.fillText(fmt(lo), 0, 26);
+  ctx.textAlign = "center"; ctx.fillText(fmt(mid), w / 2, 26);
+  ctx.textAlign = "right"; ctx.fillText(fmt(hi), w, 26);
+  ctx.textAlign = "center"; ctx.fillText(label, w / 2, 40);
 }
 const state = {id: ids[0], light: null, cam: [1, 0, 0, 0, 1, 0, 0, 0, 1], yaw: 0, pitch: 0, exposure: 1,
                theta_i: 30 * Math.PI / 180, phi_d: Math.PI / 2};
@@ -300,8 +301,8 @@ function draw() {
     ctx.stroke();
   }
   ctx.setLineDash([]); ctx.fillStyle = "#222"; ctx.font = "11px sans-serif";
-  ctx.fillText("radius: f (mean RGB), full scale " + fmt(fmax) + " 1/sr; light at " +
-               Math.round(state.theta_i * 180 / Math.PI) + " deg (grey line; mirror direction on the left)", 6, H - 4);
+  ctx.fillText("radius: f (mean RGB), full scale " + fmt(fmax) + " 1/sr; grey: light at " +
+               Math.round(state.theta_i * 180 / Math.PI) + " deg", 6, H - 4);
   $("v-info").textContent = r.label + " (" + r.method + "), light (" + state.light.map((v) => v.toFixed(2)).join(", ") +
       "), view yaw " + Math.round(state.yaw * 180 / Math.PI) + " pitch " + Math.round(state.pitch * 180 / Math.PI) + " deg";
   // Factor textures with their value scale.
