@@ -187,11 +187,17 @@ void write_report_html(const ExperimentOutput& e, const OutputFiles& f, const st
 
   // The WebGL2 viewer (experiments/viewer.h), when some run wrote its data.
   {
-    std::vector<std::string> scripts;
+    std::vector<ViewerRun> viewer_runs;
     for (const auto& r : e.runs)
-      if (r.status == "ok" && exists_in(dir, "runs/" + r.run_id + "/viewer.js"))
-        scripts.push_back("runs/" + r.run_id + "/viewer.js");
-    if (!scripts.empty()) h << viewer_section(scripts);
+      if (r.status == "ok" && exists_in(dir, "runs/" + r.run_id + "/viewer.js")) {
+        auto cell = [&](const char* c) {
+          auto it = r.row.find(c);
+          return it == r.row.end() ? std::string() : it->second;
+        };
+        viewer_runs.push_back({r.run_id, "runs/" + r.run_id + "/viewer.js",
+                               cell("brdf") + " | " + cell("label") + " " + cell("sweep")});
+      }
+    if (!viewer_runs.empty()) h << viewer_section(viewer_runs);
   }
 
   // Runs.

@@ -143,7 +143,7 @@ void write_viewer_data(const Factorization& approx, const Brdf& original, const 
   write_file_atomic(path, [&](std::ostream& o) { o << text; });
 }
 
-std::string viewer_section(const std::vector<std::string>& scripts) {
+std::string viewer_section(const std::vector<ViewerRun>& runs) {
   std::ostringstream h;
   h << "<h2 id=\"viewer-h\">Viewer</h2>\n<div id=\"viewer\">\n"
     << "<p class=\"note\">WebGL2, offline. Left to right: the original BRDF (a tabulation read by the page: "
@@ -171,9 +171,10 @@ std::string viewer_section(const std::vector<std::string>& scripts) {
     << "<h3>Factor textures</h3><div class=\"vrow\" id=\"v-textures\"></div>\n"
     << "<pre id=\"viewer-test\" hidden></pre>\n"
     << "<script type=\"x-shader/x-fragment\" id=\"v-shader-main\">" << kViewerShaderMain << "</script>\n";
-  for (const auto& s : scripts) {
+  nlohmann::json list = nlohmann::json::array();
+  for (const auto& r : runs) {
     std::string u;
-    for (unsigned char c : s) {
+    for (unsigned char c : r.path) {
       if (std::isalnum(c) || c == '/' || c == '.' || c == '_' || c == '-') {
         u += char(c);
       } else {
@@ -182,8 +183,16 @@ std::string viewer_section(const std::vector<std::string>& scripts) {
         u += buf;
       }
     }
-    h << "<script src=\"" << u << "\"></script>\n";
+    list.push_back({{"id", r.id}, {"path", u}, {"label", r.label}});
   }
+  std::string text = list.dump();
+  for (size_t p = 0; (p = text.find("</", p)) != std::string::npos; p += 3) text.replace(p, 2, "<\\/");
+  // Test mode writes every viewer.js in while the page is parsed (so the
+  // numbers exist when the page has loaded); otherwise each is loaded when its
+  // run is shown. (The attribute is spelled in pieces: this is page text.)
+  h << "<script>window.BF_VIEWER_FILES = " << text << ";\n"
+    << "if (location.hash === \"#viewer-test\") for (const f of window.BF_VIEWER_FILES) "
+       "document.write(\"<scr\" + \"ipt s\" + \"rc='\" + f.path + \"'></scr\" + \"ipt>\");</script>\n";
   h << "<script>" << kViewerScript << "</script>\n</div>\n";
   return h.str();
 }

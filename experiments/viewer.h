@@ -46,8 +46,12 @@ void write_viewer_data(const Factorization& approx, const Brdf& original, const 
                        const SceneSettings& scene, const std::string& run_id, const std::string& label,
                        const std::string& path);
 
-// The viewer section of report.html: canvas, controls and the inline script;
-// `scripts` are the viewer.js paths relative to the page.
-std::string viewer_section(const std::vector<std::string>& scripts);
+// The viewer section of report.html: canvas, controls and the inline script.
+// Each run's viewer.js (path relative to the page) is loaded when the run is
+// shown; with "#viewer-test" all are read while the page loads.
+struct ViewerRun {
+  std::string id, path, label;
+};
+std::string viewer_section(const std::vector<ViewerRun>& runs);
 
 }  // namespace bf

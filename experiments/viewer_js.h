@@ -118,8 +118,11 @@ void main() {
 inline constexpr const char* kViewerScript = R"JS(
 (function () {
 "use strict";
-const runs = window.BF_VIEWER || {};
-const ids = Object.keys(runs);
+// viewer.js files are loaded when their run is shown (each is ~1 MB); the
+// test mode (#viewer-test) has them all written in by the loader script.
+const files = window.BF_VIEWER_FILES || [];
+const runs = window.BF_VIEWER = window.BF_VIEWER || {};
+const ids = files.map((f) => f.id);
 const root = document.getElementById("viewer");
 if (!root || ids.length === 0) return;
 const testMode = location.hash === "#viewer-test";
@@ -241,7 +244,7 @@ function bar(cv, label, lo, hi, ramp, log) {
   ctx.textAlign = "right"; ctx.fillText(fmt(hi), w, 26);
   ctx.textAlign = "center"; ctx.fillText(label, w / 2, 40);
 }
-const state = {id: ids[0], light: null, cam: [1, 0, 0, 0, 1, 0, 0, 0, 1], yaw: 0, pitch: 0, exposure: 1,
+const state = {id: null, light: null, cam: [1, 0, 0, 0, 1, 0, 0, 0, 1], yaw: 0, pitch: 0, exposure: 1,
                theta_i: 30 * Math.PI / 180, phi_d: Math.PI / 2};
 const $ = (q) => document.getElementById(q);
 function camMatrix() {
@@ -324,14 +327,27 @@ function draw() {
 }
 // Controls.
 const sel = $("v-run");
-ids.forEach((id) => { const o = document.createElement("option"); o.value = id; o.textContent = id + "  " + runs[id].label; sel.appendChild(o); });
-sel.onchange = () => { state.id = sel.value; state.light = runs[state.id].scene.light.slice(); draw(); };
-// "#viewer=<run_id>" opens that run and scrolls to the viewer.
-if (location.hash.startsWith("#viewer=") && runs[location.hash.slice(8)]) {
-  state.id = location.hash.slice(8);
-  sel.value = state.id;
+files.forEach((f) => { const o = document.createElement("option"); o.value = f.id; o.textContent = f.id + "  " + f.label; sel.appendChild(o); });
+function ensure(id, then) {
+  if (runs[id]) { then(); return; }
+  const f = files.find((x) => x.id === id);
+  status.textContent = "loading " + f.path + " ...";
+  const el = document.createElement("script");
+  el.onload = () => { if (runs[id]) then(); else status.textContent = f.path + " did not define run " + id; };
+  el.onerror = () => { status.textContent = "cannot load " + f.path; };
+  el.src = f.path;
+  document.body.appendChild(el);
 }
-state.light = runs[state.id].scene.light.slice();
+function show(id) {
+  ensure(id, () => {
+    state.id = id;
+    sel.value = id;
+    state.light = runs[id].scene.light.slice();
+    draw();
+    status.textContent = "";
+  });
+}
+sel.onchange = () => show(sel.value);
 $("v-exposure").oninput = (e) => { state.exposure = Math.pow(2, +e.target.value); draw(); };
 $("v-theta").oninput = (e) => { state.theta_i = +e.target.value * Math.PI / 180; draw(); };
 $("v-reset").onclick = () => { state.light = runs[state.id].scene.light.slice(); state.yaw = state.pitch = 0; state.cam = camMatrix(); draw(); };
@@ -373,8 +389,9 @@ if (testMode) {
   }
   $("viewer-test").textContent = out.join("\n");
 }
-draw();
-status.textContent = "";
+// "#viewer=<run_id>" opens that run and scrolls to the viewer.
+const wanted = location.hash.startsWith("#viewer=") ? location.hash.slice(8) : "";
+show(ids.includes(wanted) ? wanted : ids[0]);
 if (location.hash.startsWith("#viewer")) $("viewer-h").scrollIntoView();
 })();
 )JS";
