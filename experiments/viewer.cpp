@@ -15,6 +15,7 @@
 #include "factor/glsl.h"
 #include "factor/homomorphic.h"
 #include "factor/image_io.h"
+#include "factor/lighting.h"
 #include "factor/svd_baseline.h"
 
 namespace bf {
@@ -135,6 +136,28 @@ void write_viewer_data(const Factorization& approx, const Brdf& original, const 
     if (peaks[q] > 0 && std::isfinite(peaks[q])) white = peaks[q];
   }
   j["exposure"] = 1.0 / white;
+  // SH-lit scene (factor/lighting.h): the band-limited radiance on a lat-long
+  // grid and LitShader's hemisphere rule (local frame), so the page shades as
+  // render_sphere does: sum over nodes of w s.z L(M s) f(s, wo).
+  if (scene.lighting) {
+    const int W = kViewerEnvWidth, H = W / 2;
+    std::vector<float> env(size_t(W) * H * 3);
+    for (int y = 0; y < H; ++y)
+      for (int x = 0; x < W; ++x) {
+        const double th = M_PI * (y + 0.5) / H, ph = 2.0 * M_PI * (x + 0.5) / W;
+        const Rgb L = scene.lighting->radiance(Vec3(std::sin(th) * std::cos(ph), std::sin(th) * std::sin(ph), std::cos(th)));
+        for (int c = 0; c < 3; ++c) env[(size_t(y) * W + x) * 3 + c] = float(std::isfinite(L[c]) ? L[c] : 0.0);
+      }
+    const LitShader shader(scene.lighting, scene.lighting_nodes);
+    const SphereRule& rule = shader.rule();
+    std::vector<float> nodes;
+    for (size_t k = 0; k < rule.size(); ++k) {
+      for (int c = 0; c < 3; ++c) nodes.push_back(float(rule.dir[k][c]));
+      nodes.push_back(float(rule.w[k]));
+    }
+    j["environment"] = {{"width", W}, {"height", H}, {"data", base64(env)}, {"nodes", rule.size()},
+                        {"rule", base64(nodes)}};
+  }
   j["scene"] = {{"light", {scene.light.x(), scene.light.y(), scene.light.z()}},
                 {"intensity", scene.intensity},
                 {"size", scene.size}};
@@ -155,7 +178,8 @@ std::string viewer_section(const std::vector<ViewerRun>& runs) {
     << "<p><label>Run <select id=\"v-run\"></select></label> "
     << "<label>exposure <input id=\"v-exposure\" type=\"range\" min=\"-6\" max=\"6\" step=\"0.5\" value=\"0\"></label> "
     << "<label>lobe incidence &theta;<sub>i</sub> <input id=\"v-theta\" type=\"range\" min=\"0\" max=\"89\" "
-       "value=\"30\"></label> <button id=\"v-reset\">reset light and view</button> <span id=\"v-status\">"
+       "value=\"30\"></label> <button id=\"v-reset\">reset light and view</button> <label><input id=\"v-env\" type=\"checkbox\" "
+       "checked> light by the scene's environment (SH lighting; when the scene has one)</label> <span id=\"v-status\">"
        "loading&hellip;</span></p>\n"
     << "<p id=\"v-info\"></p>\n"
     << "<div class=\"vrow\"><figure><canvas id=\"v-orig\"></canvas><figcaption>original</figcaption></figure>"

@@ -35,6 +35,8 @@ namespace bf {
 // about 0.8 MB of float32 (1 MB of base64) per run.
 inline constexpr int kViewerTableRes = 16;
 inline constexpr int kViewerIsoThetaH = 64, kViewerIsoThetaD = 32, kViewerIsoPhiD = 32;
+// SH-lit scenes: the band-limited lighting on a W x W/2 lat-long grid.
+inline constexpr int kViewerEnvWidth = 128;
 
 // True when the viewer can show this factorization (it has exported GLSL:
 // mccool, fit, search, svd, sh-k, sh-r).

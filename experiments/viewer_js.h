@@ -15,7 +15,28 @@ uniform vec2 u_size;
 uniform mat3 u_cam;      // world = u_cam * camera
 uniform float u_theta_i;
 uniform float u_phi_d;
+uniform int u_env;          // 1: light by the scene's SH lighting (lat-long bf_env, rule bf_rule)
+uniform sampler2D bf_env;
+uniform sampler2D bf_rule;  // node k at (k, 0): (direction in the local frame, weight)
+uniform int u_rule_n;
 out vec4 o_color;
+
+// Bilinear lookup of the lat-long map (theta = pi (y + 1/2) / H, phi = 2 pi (x + 1/2) / W),
+// wrapping in phi, clamped in theta.
+vec3 bf_env_radiance(vec3 w) {
+  ivec2 sz = textureSize(bf_env, 0);
+  float th = acos(clamp(w.z, -1.0, 1.0));
+  float ph = atan(w.y, w.x);
+  if (ph < 0.0) ph += 6.28318531;
+  float x = ph / 6.28318531 * float(sz.x) - 0.5, y = clamp(th / 3.14159265 * float(sz.y) - 0.5, 0.0, float(sz.y - 1));
+  float fx = floor(x);
+  int x0 = int(fx), y0 = min(int(y), sz.y - 2);
+  float a = x - fx, b = y - float(y0);
+  int xa = (x0 + sz.x) % sz.x, xb = (xa + 1) % sz.x;  // x0 >= -1
+  vec3 t00 = texelFetch(bf_env, ivec2(xa, y0), 0).rgb, t10 = texelFetch(bf_env, ivec2(xb, y0), 0).rgb;
+  vec3 t01 = texelFetch(bf_env, ivec2(xa, y0 + 1), 0).rgb, t11 = texelFetch(bf_env, ivec2(xb, y0 + 1), 0).rgb;
+  return mix(mix(t00, t10, a), mix(t01, t11, a), b);
+}
 
 vec2 bf_orig_parabolic(vec3 w) { return w.xy / (1.0 + w.z); }
 vec3 bf_orig_eval(vec3 wi, vec3 wo) {
@@ -93,7 +114,18 @@ void main() {
     vec3 wi = vec3(dot(wiw, t), dot(wiw, b), dot(wiw, n));
     vec3 wo = vec3(dot(wo_w, t), dot(wo_w, b), dot(wo_w, n));
     vec3 L = vec3(0.0);
-    if (ci > 0.0 && wo.z > 0.0) L = u_intensity * bf_eval(normalize(wi), normalize(wo)) * ci / d2;
+    if (u_env == 1) {
+      if (wo.z > 0.0) {
+        vec3 won = normalize(wo);
+        for (int k = 0; k < u_rule_n; ++k) {
+          vec4 node = texelFetch(bf_rule, ivec2(k, 0), 0);
+          vec3 sw = node.x * t + node.y * b + node.z * n;
+          L += node.w * node.z * bf_env_radiance(sw) * bf_eval(node.xyz, won);
+        }
+      }
+    } else if (ci > 0.0 && wo.z > 0.0) {
+      L = u_intensity * bf_eval(normalize(wi), normalize(wo)) * ci / d2;
+    }
     o_color = vec4(L, 1.0);
   } else if (u_mode == 1) {
     // BRDF Explorer's image slice: theta_h along x, theta_d along y (up), phi_d fixed,
@@ -145,11 +177,12 @@ function compile(type, src) {
   if (!gl.getShaderParameter(s, gl.COMPILE_STATUS)) throw new Error(gl.getShaderInfoLog(s));
   return s;
 }
-function texture(w, h, data) {
+function texture(w, h, data, rgba) {
   const t = gl.createTexture();
   gl.bindTexture(gl.TEXTURE_2D, t);
   gl.pixelStorei(gl.UNPACK_ALIGNMENT, 1);
-  gl.texImage2D(gl.TEXTURE_2D, 0, gl.RGB32F, w, h, 0, gl.RGB, gl.FLOAT, data);
+  if (rgba) gl.texImage2D(gl.TEXTURE_2D, 0, gl.RGBA32F, w, h, 0, gl.RGBA, gl.FLOAT, data);
+  else gl.texImage2D(gl.TEXTURE_2D, 0, gl.RGB32F, w, h, 0, gl.RGB, gl.FLOAT, data);
   for (const p of [gl.TEXTURE_MIN_FILTER, gl.TEXTURE_MAG_FILTER]) gl.texParameteri(gl.TEXTURE_2D, p, gl.NEAREST);
   for (const p of [gl.TEXTURE_WRAP_S, gl.TEXTURE_WRAP_T]) gl.texParameteri(gl.TEXTURE_2D, p, gl.CLAMP_TO_EDGE);
   return t;
@@ -172,6 +205,9 @@ function setup(id) {
   const o = r.original;
   units.push({name: "bf_orig", tex: o.kind === "iso" ? texture(o.np * o.nd, o.nh, b64floats(o.data))
                                                     : texture(o.res * o.res, o.res * o.res, b64floats(o.data))});
+  const e = r.environment;
+  units.push({name: "bf_env", tex: e ? texture(e.width, e.height, b64floats(e.data)) : texture(2, 2, new Float32Array(12))});
+  units.push({name: "bf_rule", tex: e ? texture(e.nodes, 1, b64floats(e.rule), true) : texture(1, 1, new Float32Array(4), true)});
   cache[id] = {prog, units};
   return cache[id];
 }
@@ -199,6 +235,8 @@ function run(id, mode, which, w, h, u) {
   gl.uniformMatrix3fv(L("u_cam"), false, u.cam);
   gl.uniform1f(L("u_theta_i"), u.theta_i);
   gl.uniform1f(L("u_phi_d"), u.phi_d);
+  gl.uniform1i(L("u_env"), u.env && r.environment ? 1 : 0);
+  gl.uniform1i(L("u_rule_n"), r.environment ? r.environment.nodes : 0);
   gl.drawArrays(gl.TRIANGLES, 0, 3);
   const px = new Float32Array(w * h * 4);
   gl.readPixels(0, 0, w, h, gl.RGBA, gl.FLOAT, px);
@@ -245,14 +283,14 @@ function bar(cv, label, lo, hi, ramp, log) {
   ctx.textAlign = "center"; ctx.fillText(label, w / 2, 40);
 }
 const state = {id: null, light: null, cam: [1, 0, 0, 0, 1, 0, 0, 0, 1], yaw: 0, pitch: 0, exposure: 1,
-               theta_i: 30 * Math.PI / 180, phi_d: Math.PI / 2};
+               theta_i: 30 * Math.PI / 180, phi_d: Math.PI / 2, env: true};
 const $ = (q) => document.getElementById(q);
 function camMatrix() {
   const cy = Math.cos(state.yaw), sy = Math.sin(state.yaw), cp = Math.cos(state.pitch), sp = Math.sin(state.pitch);
   // world = Ry(yaw) Rx(pitch) camera, column-major for uniformMatrix3fv.
   return [cy, 0, -sy, sy * sp, cp, cy * sp, sy * cp, -sp, cy * cp];
 }
-function uniforms() { return {light: state.light, cam: state.cam, theta_i: state.theta_i, phi_d: state.phi_d}; }
+function uniforms() { return {light: state.light, cam: state.cam, theta_i: state.theta_i, phi_d: state.phi_d, env: state.env}; }
 function draw() {
   const id = state.id, r = runs[id], n = 160;
   const u = uniforms();
@@ -306,7 +344,9 @@ function draw() {
   ctx.setLineDash([]); ctx.fillStyle = "#222"; ctx.font = "11px sans-serif";
   ctx.fillText("radius: f (mean RGB), full scale " + fmt(fmax) + " 1/sr; grey: light at " +
                Math.round(state.theta_i * 180 / Math.PI) + " deg", 6, H - 4);
-  $("v-info").textContent = r.label + " (" + r.method + "), light (" + state.light.map((v) => v.toFixed(2)).join(", ") +
+  $("v-info").textContent = r.label + " (" + r.method + "), " +
+      (state.env && r.environment ? "lit by the scene's SH lighting (" + r.environment.nodes + " hemisphere nodes per pixel)"
+                                  : "point light (" + state.light.map((v) => v.toFixed(2)).join(", ") + ")") +
       "), view yaw " + Math.round(state.yaw * 180 / Math.PI) + " pitch " + Math.round(state.pitch * 180 / Math.PI) + " deg";
   // Factor textures with their value scale.
   const tx = $("v-textures");
@@ -343,11 +383,13 @@ function show(id) {
     state.id = id;
     sel.value = id;
     state.light = runs[id].scene.light.slice();
+    $("v-env").disabled = !runs[id].environment;
     draw();
     status.textContent = "";
   });
 }
 sel.onchange = () => show(sel.value);
+$("v-env").onchange = (e) => { state.env = e.target.checked; draw(); };
 $("v-exposure").oninput = (e) => { state.exposure = Math.pow(2, +e.target.value); draw(); };
 $("v-theta").oninput = (e) => { state.theta_i = +e.target.value * Math.PI / 180; draw(); };
 $("v-reset").onclick = () => { state.light = runs[state.id].scene.light.slice(); state.yaw = state.pitch = 0; state.cam = camMatrix(); draw(); };
@@ -384,6 +426,10 @@ if (testMode) {
       rec.slice = pick(run(id, 1, 1, 16, 16, u), 16, 16);
       rec.lobe = pick(run(id, 2, 1, 32, 1, u), 32, 1);
       rec.lobe_original = pick(run(id, 2, 0, 32, 1, u), 32, 1);
+      if (r.environment) {
+        const ue = Object.assign({}, u, {env: true});
+        rec.approx_env = pick(run(id, 0, 1, n, n, ue), n, n);
+      }
     } catch (e) { rec.error = String(e.message || e); }
     out.push(JSON.stringify(rec));
   }

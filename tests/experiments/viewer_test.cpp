@@ -11,6 +11,7 @@
 
 #include "brdfs/catalogue.h"
 #include "brdfs/directions.h"
+#include "experiments/config.h"
 #include "experiments/render.h"
 #include "experiments_helpers.h"
 
@@ -181,4 +182,72 @@ TEST_CASE("viewer: headless Chromium renders every kind as the CPU does") {
     }
   }
   CHECK(runs == 5);
+}
+
+TEST_CASE("viewer: under the scene's SH lighting the page shades as render_sphere") {
+  const std::string browser = chromium();
+  if (browser.empty()) {
+    WARN("chromium not installed (scripts/install-deps.sh installs it): viewer not tested");
+    return;
+  }
+  ScratchDir dir;
+  const std::string cfg = write_text(dir / "env.toml", R"(
+[experiment]
+name = "viewer-env"
+[[brdf]]
+preset = "bluepaint"
+[sampling]
+kind = "grid"
+resolution = 6
+[scene]
+size = 24
+lighting_order = 4
+[[method]]
+kind = "mccool"
+texture_size = 8
+[[method]]
+kind = "svd"
+terms = 2
+texture_size = 10
+)");
+  const RunSummary s = run_quiet(cfg, dir / "out");
+  REQUIRE(s.failed == 0);
+  const Plan plan = load_plan(cfg);
+  REQUIRE(plan.scene.lighting);
+  const std::string page = dir / "out/report.html", dom = dir / "dom.html";
+  const std::string cmd = browser + " --headless --no-sandbox --use-gl=swiftshader --enable-unsafe-swiftshader "
+                          "--disable-gpu-sandbox --dump-dom 'file://" + page + "#viewer-test' > " + dom +
+                          " 2> " + (dir / "chromium.log");
+  REQUIRE(std::system(cmd.c_str()) == 0);
+  const std::string text = read_text(dom);
+  const size_t at = text.find("<pre id=\"viewer-test\"");
+  REQUIRE(at != std::string::npos);
+  const size_t open = text.find('>', at) + 1, close = text.find("</pre>", open);
+  std::istringstream lines(text.substr(open, close - open));
+  std::string line;
+  int runs = 0;
+  while (std::getline(lines, line)) {
+    if (line.empty()) continue;
+    const auto j = nlohmann::json::parse(line);
+    INFO("run " << j.at("run").get<std::string>());
+    REQUIRE(!j.contains("error"));
+    REQUIRE(j.contains("approx_env"));
+    ++runs;
+    const BrdfPtr approx = Catalogue::global().make(dir / ("out/runs/" + j.at("run").get<std::string>() + "/factors.json"));
+    const SphereRender cpu = render_sphere(*approx, plan.scene);
+    const auto gpu = j.at("approx_env").get<std::vector<double>>();
+    REQUIRE(gpu.size() == cpu.L.size() * 3);
+    double worst = 0, peak = 0;
+    for (size_t k = 0; k < cpu.L.size(); ++k)
+      for (int c = 0; c < 3; ++c) {
+        worst = std::max(worst, std::abs(gpu[3 * k + c] - cpu.L[k][c]));
+        peak = std::max(peak, std::abs(cpu.L[k][c]));
+      }
+    INFO(approx->to_string() << ": worst |gpu - cpu| = " << worst << " of peak " << peak);
+    REQUIRE(peak > 0);
+    // The page reads the band-limited lighting from a 128 x 64 lat-long grid
+    // (bilinear) where the CPU evaluates the SH series: 2e-3 of the peak.
+    CHECK(worst <= 2e-3 * peak);
+  }
+  CHECK(runs == 2);
 }
