@@ -60,9 +60,11 @@ uint64_t estimate_output_bytes(const Plan& plan, const std::vector<bool>& todo) 
       const uint64_t order = uint64_t(std::max({m.shk.order, m.cap, 0}) + 1);
       if (m.kind == "svd") bytes += uint64_t(std::max({m.svd.rank, m.terms, m.cap, 1})) * 2 * res * res * 3 * 18;
       if (m.kind == "sh-k") bytes += order * order * res * res * 3 * 18;
-      if (plan.experiment.render && m.kind != "model-fit")
+      if (plan.experiment.render && m.kind != "model-fit") {
         bytes += uint64_t(kViewerTableRes) * kViewerTableRes * kViewerTableRes * kViewerTableRes * 3 * 4 * 4 / 3 +
                  (uint64_t(64) << 10);
+        if (plan.scene.lighting) bytes += uint64_t(kViewerEnvWidth) * (kViewerEnvWidth / 2) * 3 * 4 * 4 / 3 + (uint64_t(64) << 10);
+      }
     }
   }
   return bytes;
