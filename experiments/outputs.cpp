@@ -61,7 +61,7 @@ std::vector<std::string> display_columns(const std::vector<RunEntry>& runs) {
         break;
       }
     }
-  return cols;
+  return key_columns_first(cols);  // experiments/report.h
 }
 
 std::string format_number(double v) {
@@ -277,6 +277,9 @@ void write_results_md(const ExperimentOutput& e, const OutputFiles& f, const std
     o << "- files: [results.csv](results.csv) (full precision and extra columns), "
          "[manifest.json](manifest.json), [report.html](report.html)\n\n";
     const std::vector<std::string> cols = display_columns(e.runs);
+    const auto marked = best_cells(e.runs, cols);  // experiments/report.h
+    o << "Key columns first; **bold**: the best (lowest) value of that column among the runs of the same "
+         "BRDF.\n\n";
     o << "|";
     for (const auto& c : cols) o << " " << c << " |";
     o << "\n|";
@@ -289,6 +292,7 @@ void write_results_md(const ExperimentOutput& e, const OutputFiles& f, const std
         std::string cell = it == r.row.end() ? "" : it->second;
         if (c == "run_id" && r.status == "ok") cell = "[" + cell + "](runs/" + cell + "/run.json)";
         else if (c != "run_id") cell = format_short(cell);
+        if (!cell.empty() && marked.count({size_t(&r - e.runs.data()), c})) cell = "**" + cell + "**";
         o << " " << md_cell(cell) << " |";
       }
       o << "\n";

@@ -1,11 +1,15 @@
 // report.html (see report.h).
 #include "experiments/report.h"
 
+#include <algorithm>
+#include <cstdlib>
 #include <filesystem>
+#include <map>
 #include <regex>
 #include <sstream>
 
 #include "experiments/cli_util.h"
+#include "experiments/viewer.h"
 
 namespace bf {
 
@@ -46,10 +50,14 @@ body{font-family:system-ui,-apple-system,Segoe UI,Helvetica,Arial,sans-serif;mar
 h1{font-size:1.6em}h2{font-size:1.25em;margin-top:2em;border-bottom:1px solid #ddd}
 table{border-collapse:collapse;font-size:0.82em}td,th{border:1px solid #ccc;padding:2px 6px;text-align:right}
 th{background:#f0f0f0;position:sticky;top:0}td.t{text-align:left}tr.failed td{background:#fde8e8}
+td.best,span.best{font-weight:bold;background:#dff3df}.tablewrap{overflow-x:auto;max-width:100%}p.note{font-size:0.85em;color:#555}
 .plots img{max-width:45%;margin:0.5em;border:1px solid #ddd}
 .run{border:1px solid #ddd;border-radius:6px;padding:0.6em 1em;margin:1em 0}
 .run img.sphere{max-width:100%;image-rendering:pixelated}.run img.tex{height:96px;margin-right:4px;image-rendering:pixelated}
-.files a{margin-right:0.8em;font-size:0.85em}code{background:#f6f6f6;padding:0 3px}
+.files a{margin-right:0.8em;font-size:0.85em}
+.vrow{display:flex;flex-wrap:wrap;gap:1em;align-items:flex-start}.vrow figure{margin:0}
+#viewer canvas#v-orig,#viewer canvas#v-approx,#viewer canvas#v-diff{width:256px;height:256px;cursor:crosshair}
+#viewer canvas#v-slice-orig,#viewer canvas#v-slice-approx{width:180px;height:180px;image-rendering:pixelated}code{background:#f6f6f6;padding:0 3px}
 pre{background:#f6f6f6;padding:0.8em;overflow:auto;font-size:0.85em}
 )";
 
@@ -59,6 +67,52 @@ bool exists_in(const std::string& dir, const std::string& rel) {
 }
 
 }  // namespace
+
+std::vector<std::string> key_columns_first(const std::vector<std::string>& cols) {
+  static const std::vector<std::string> key = {"brdf",          "method",  "label",      "rel_mse",
+                                               "cos_rmse",      "shade_rmse", "storage_floats",
+                                               "seconds",       "evaluations"};
+  std::vector<std::string> out;
+  for (const auto& k : key)
+    if (std::find(cols.begin(), cols.end(), k) != cols.end()) out.push_back(k);
+  for (const auto& c : cols)
+    if (std::find(out.begin(), out.end(), c) == out.end()) out.push_back(c);
+  return out;
+}
+
+bool is_marked_column(const std::string& c) {
+  static const std::set<std::string> m = {"rel_mse", "rel_mae", "rel_max", "lin_rmse", "lin_mae", "lin_max",
+                                          "cos_rmse", "shade_rmse", "storage_floats", "seconds"};
+  return m.count(c) > 0;
+}
+
+std::set<std::pair<size_t, std::string>> best_cells(const std::vector<RunEntry>& runs,
+                                                    const std::vector<std::string>& cols) {
+  std::set<std::pair<size_t, std::string>> out;
+  for (const auto& c : cols) {
+    if (!is_marked_column(c)) continue;
+    // Per BRDF: the smallest value and every run holding it.
+    std::map<std::string, std::vector<std::pair<double, size_t>>> by_brdf;
+    for (size_t i = 0; i < runs.size(); ++i) {
+      if (runs[i].status != "ok") continue;
+      auto it = runs[i].row.find(c);
+      auto b = runs[i].row.find("brdf");
+      if (it == runs[i].row.end() || it->second.empty() || b == runs[i].row.end()) continue;
+      char* end = nullptr;
+      const double v = std::strtod(it->second.c_str(), &end);
+      if (end == it->second.c_str() || *end != '\0' || !std::isfinite(v)) continue;
+      by_brdf[b->second].emplace_back(v, i);
+    }
+    for (const auto& [brdf, vals] : by_brdf) {
+      if (vals.size() < 2) continue;
+      double best = vals[0].first;
+      for (const auto& [v, i] : vals) best = std::min(best, v);
+      for (const auto& [v, i] : vals)
+        if (v == best) out.emplace(i, c);
+    }
+  }
+  return out;
+}
 
 std::vector<std::string> html_links(const std::string& html) {
   std::vector<std::string> out;
@@ -91,8 +145,11 @@ void write_report_html(const ExperimentOutput& e, const OutputFiles& f, const st
   h << "</p>\n";
 
   // Results table.
-  h << "<h2>Results</h2>\n<table><tr>";
+  h << "<h2>Results</h2>\n<p class=\"note\">Key columns first. <span class=\"best\">Green bold</span>: "
+       "the best (lowest) value of that column among the runs of the same BRDF.</p>\n"
+       "<div class=\"tablewrap\"><table><tr>";
   const std::vector<std::string> cols = display_columns(e.runs);
+  const auto marked = best_cells(e.runs, cols);
   for (const auto& c : cols) h << "<th>" << esc(c) << "</th>";
   h << "</tr>\n";
   for (const auto& r : e.runs) {
@@ -103,14 +160,16 @@ void write_report_html(const ExperimentOutput& e, const OutputFiles& f, const st
       const bool text = c == "run_id" || c == "brdf" || c == "method" || c == "label" || c == "parameterization" ||
                         c == "sampling" || c == "notes" || c == "reciprocity" || c == "sweep" ||
                         c == "tolerance";
-      h << "<td" << (text ? " class=\"t\"" : "") << ">";
+      const bool best = marked.count({size_t(&r - e.runs.data()), c}) > 0;
+      h << "<td" << (text ? " class=\"t\"" : best ? " class=\"best\" title=\"best " + esc(c) + " of this BRDF\"" : "")
+        << ">";
       if (c == "run_id") h << "<a href=\"#run-" << esc(cell) << "\">" << esc(cell) << "</a>";
       else h << esc(text ? cell : format_short(cell));
       h << "</td>";
     }
     h << "</tr>\n";
   }
-  h << "</table>\n";
+  h << "</table></div>\n";
 
   // Plots.
   h << "<h2>Plots</h2>\n";
@@ -124,6 +183,21 @@ void write_report_html(const ExperimentOutput& e, const OutputFiles& f, const st
         else h << "<a href=\"" << url(p) << "\">" << esc(p) << "</a> ";
       }
     h << "</div>\n";
+  }
+
+  // The WebGL2 viewer (experiments/viewer.h), when some run wrote its data.
+  {
+    std::vector<ViewerRun> viewer_runs;
+    for (const auto& r : e.runs)
+      if (r.status == "ok" && exists_in(dir, "runs/" + r.run_id + "/viewer.js")) {
+        auto cell = [&](const char* c) {
+          auto it = r.row.find(c);
+          return it == r.row.end() ? std::string() : it->second;
+        };
+        viewer_runs.push_back({r.run_id, "runs/" + r.run_id + "/viewer.js",
+                               cell("brdf") + " | " + cell("label") + " " + cell("sweep")});
+      }
+    if (!viewer_runs.empty()) h << viewer_section(viewer_runs);
   }
 
   // Runs.

@@ -5,7 +5,10 @@
 // archived as a whole.
 #pragma once
 
+#include <set>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "experiments/outputs.h"
 
@@ -17,5 +20,22 @@ void write_report_html(const ExperimentOutput& e, const OutputFiles& files, cons
 // Every href and src attribute value of an HTML page, in order (tests use it
 // to check that all of them resolve).
 std::vector<std::string> html_links(const std::string& html);
+
+// The table columns reordered for people: the columns that answer "how good,
+// at what storage and time" first (brdf, method, label, rel_mse, cos_rmse,
+// shade_rmse, storage_floats, seconds, evaluations), then the rest in their
+// given order (run_id after the errors, before the extras).
+std::vector<std::string> key_columns_first(const std::vector<std::string>& cols);
+
+// Columns where lower is better and the best value per BRDF is marked: every
+// error column (rel_*, lin_*, cos_rmse, shade_rmse) and storage_floats and
+// seconds.
+bool is_marked_column(const std::string& col);
+
+// The cells holding the best (smallest) value of each marked column among the
+// finished runs of the same BRDF, as (run index, column); ties are all marked.
+// Only columns with at least two runs of that BRDF holding a value take part.
+std::set<std::pair<size_t, std::string>> best_cells(const std::vector<RunEntry>& runs,
+                                                    const std::vector<std::string>& cols);
 
 }  // namespace bf

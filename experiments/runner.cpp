@@ -22,6 +22,8 @@
 #include "experiments/cli_util.h"
 #include "experiments/render.h"
 #include "experiments/preflight.h"
+#include "experiments/viewer.h"
+#include "factor/baseline_export.h"
 #include "factor/export.h"
 #include "factor/isotropy.h"
 #include "factor/lighting.h"
@@ -514,12 +516,19 @@ RunEntry execute_run(const Plan& plan, const PlannedRun& pr, const SampleSet& sa
     else {
       const json d = f->describe();
       write_file_atomic((run_dir / "factorization.json").string(), [&](std::ostream& o) { o << d.dump(2) << "\n"; });
+      // svd, sh-k, sh-r: the loadable export (factor/baseline_export.h).
+      if (is_baseline_method(f->method())) write_baseline_export(*f, run_dir.string(), "factors");
     }
   }
   if (plan.experiment.render) {
     const auto original = renders.get(plan, pr.brdf);
     const SphereRender approx = render_sphere(*f, plan.scene);
     write_comparison_png(*original, approx, (run_dir / "sphere.png").string());
+    // report.html's WebGL2 viewer data (experiments/viewer.h).
+    if (plan.experiment.export_factors && viewer_supports(*f))
+      write_viewer_data(*f, *plan.brdfs[pr.brdf].brdf, *original, plan.scene, pr.run_id,
+                        plan.brdfs[pr.brdf].label + " | " + row["label"] + " " + row["sweep"],
+                        (run_dir / "viewer.js").string());
     if (approx.nonfinite) notes.push_back(std::to_string(approx.nonfinite) + " non-finite pixels rendered as 0");
     if (plan.scene.named) row["shade_rmse"] = format_number(shade_rmse(*original, approx));
   }

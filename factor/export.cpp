@@ -15,6 +15,7 @@
 #include <stdexcept>
 
 #include "brdfs/catalogue.h"
+#include "factor/baseline_export.h"
 #include "factor/glsl.h"
 #include "factor/image_io.h"
 #include "factor/model_fit.h"
@@ -487,6 +488,8 @@ void register_export_loader(Catalogue& cat) {
     options.check_unused("factorization sidecar", {});
     // A model fit's file (factor/model_fit.h) is a catalogue spec in JSON.
     if (is_model_fit_file(path)) return load_model_fit(path);
+    // SVD / SH exports (factor/baseline_export.h) dispatch on the sidecar's method.
+    if (is_baseline_method(sidecar_method(path))) return load_baseline_export(path);
     return load_factorization(path);
   });
 }

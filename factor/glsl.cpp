@@ -1,6 +1,8 @@
 // GLSL generation for exported factorizations (see glsl.h).
 #include "factor/glsl.h"
 
+#include "factor/glsl_target.h"
+
 #include <cmath>
 #include <cstdio>
 #include <sstream>
@@ -127,10 +129,11 @@ std::string generate_glsl(const HomomorphicFactorization& f,
     << (f.subtract_eps() ? " - eps * A" : "") << ", clamped at 0.\n"
     << "// eps * A is " << (f.subtract_eps() ? "" : "NOT ") << "subtracted (eps = "
     << lit(f.eps(), "eps") << ").\n\n";
+  o << glsl_target_prelude() << "\n";
 
   for (size_t k = 0; k < terms.size(); ++k) {
     const FactorTerm& t = terms[k];
-    o << "uniform sampler2D " << glsl_sampler_name(k) << ";  // term " << k;
+    o << glsl_sampler_decl(glsl_sampler_name(k), int(k)) << "  // term " << k;
     if (!texture_files.empty()) o << ": " << texture_files[k];
     o << ", " << t.proj.res << "x" << t.proj.res << ", " << to_string(t.proj.param)
       << (t.reciprocal ? ", reciprocal" : "") << "\n";

@@ -30,6 +30,7 @@ PACKAGES=(
   python3-pytest         # the Python module's tests (python/tests/)
   git                    # the build's commit in run records (a runner test needs it)
   util-linux             # unshare: a test mounts a folder read-only (CI runs as root)
+  chromium               # headless test of report.html's WebGL2 viewer
 )
 case "${1:-}" in
   "") ;;

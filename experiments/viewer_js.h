@@ -1,0 +1,445 @@
+// The inline script and shader of report.html's viewer (see viewer.h).
+#pragma once
+
+namespace bf {
+
+// Fragment-shader body appended after "#version 300 es", the run's exported
+// GLSL and "const int BF_ORIG_RES = R;".
+inline constexpr const char* kViewerShaderMain = R"GLSL(
+uniform sampler2D bf_orig;
+uniform vec3 u_light;
+uniform float u_intensity;
+uniform int u_mode;      // 0 sphere, 1 theta_h-theta_d slice, 2 in-plane lobe
+uniform int u_which;     // 0 original (tabulation), 1 approximation (exported GLSL)
+uniform vec2 u_size;
+uniform mat3 u_cam;      // world = u_cam * camera
+uniform float u_theta_i;
+uniform float u_phi_d;
+uniform int u_env;          // 1: light by the scene's SH lighting (lat-long bf_env, rule bf_rule)
+uniform sampler2D bf_env;
+uniform sampler2D bf_rule;  // node k at (k, 0): (direction in the local frame, weight)
+uniform int u_rule_n;
+out vec4 o_color;
+
+// Bilinear lookup of the lat-long map (theta = pi (y + 1/2) / H, phi = 2 pi (x + 1/2) / W),
+// wrapping in phi, clamped in theta.
+vec3 bf_env_radiance(vec3 w) {
+  ivec2 sz = textureSize(bf_env, 0);
+  float th = acos(clamp(w.z, -1.0, 1.0));
+  float ph = atan(w.y, w.x);
+  if (ph < 0.0) ph += 6.28318531;
+  float x = ph / 6.28318531 * float(sz.x) - 0.5, y = clamp(th / 3.14159265 * float(sz.y) - 0.5, 0.0, float(sz.y - 1));
+  float fx = floor(x);
+  int x0 = int(fx), y0 = min(int(y), sz.y - 2);
+  float a = x - fx, b = y - float(y0);
+  int xa = (x0 + sz.x) % sz.x, xb = (xa + 1) % sz.x;  // x0 >= -1
+  vec3 t00 = texelFetch(bf_env, ivec2(xa, y0), 0).rgb, t10 = texelFetch(bf_env, ivec2(xb, y0), 0).rgb;
+  vec3 t01 = texelFetch(bf_env, ivec2(xa, y0 + 1), 0).rgb, t11 = texelFetch(bf_env, ivec2(xb, y0 + 1), 0).rgb;
+  return mix(mix(t00, t10, a), mix(t01, t11, a), b);
+}
+
+vec2 bf_orig_parabolic(vec3 w) { return w.xy / (1.0 + w.z); }
+vec3 bf_orig_eval(vec3 wi, vec3 wo) {
+  if (wi.z <= 0.0 || wo.z <= 0.0) return vec3(0.0);
+  const int R = BF_ORIG_RES;
+  float Rm = float(R - 1);
+  vec2 si = clamp((bf_orig_parabolic(wi) + 1.0) * 0.5 * Rm, vec2(0.0), vec2(Rm));
+  vec2 so = clamp((bf_orig_parabolic(wo) + 1.0) * 0.5 * Rm, vec2(0.0), vec2(Rm));
+  ivec2 ii = min(ivec2(si), ivec2(R - 2)), io = min(ivec2(so), ivec2(R - 2));
+  vec2 ai = si - vec2(ii), ao = so - vec2(io);
+  vec3 acc = vec3(0.0);
+  for (int a = 0; a < 4; ++a) {
+    ivec2 di = ivec2(a % 2, a / 2);
+    float wa = (di.x == 1 ? ai.x : 1.0 - ai.x) * (di.y == 1 ? ai.y : 1.0 - ai.y);
+    ivec2 ti = ii + di;
+    for (int b = 0; b < 4; ++b) {
+      ivec2 dd = ivec2(b % 2, b / 2);
+      float wb = (dd.x == 1 ? ao.x : 1.0 - ao.x) * (dd.y == 1 ? ao.y : 1.0 - ao.y);
+      ivec2 to = io + dd;
+      acc += wa * wb * texelFetch(bf_orig, ivec2(to.y * R + to.x, ti.y * R + ti.x), 0).rgb;
+    }
+  }
+  return acc;
+}
+// Isotropic originals: MERL-style (theta_h, theta_d, phi_d) table, nodes at
+// theta_h = (i/(NH-1))^2 pi/2, theta_d = j/(ND-1) pi/2, phi_d = k/(NP-1) pi,
+// pixel (k + NP j, i); read trilinearly, phi_d folded into [0, pi].
+vec3 bf_orig_iso(vec3 wi, vec3 wo) {
+  if (wi.z <= 0.0 || wo.z <= 0.0) return vec3(0.0);
+  const float HP = 1.57079633;
+  vec3 h = normalize(wi + wo);
+  float th = acos(clamp(h.z, -1.0, 1.0));
+  float ph = (h.x == 0.0 && h.y == 0.0) ? 0.0 : atan(h.y, h.x);
+  vec3 d = vec3(cos(ph) * wi.x + sin(ph) * wi.y, -sin(ph) * wi.x + cos(ph) * wi.y, wi.z);
+  d = vec3(cos(th) * d.x - sin(th) * d.z, d.y, sin(th) * d.x + cos(th) * d.z);
+  float td = acos(clamp(d.z, -1.0, 1.0));
+  float pd = (d.x == 0.0 && d.y == 0.0) ? 0.0 : atan(d.y, d.x);
+  if (pd < 0.0) pd += 2.0 * HP;
+  vec3 c = vec3(sqrt(clamp(th / HP, 0.0, 1.0)) * float(BF_ORIG_NH - 1), clamp(td / HP, 0.0, 1.0) * float(BF_ORIG_ND - 1),
+                clamp(pd / (2.0 * HP), 0.0, 1.0) * float(BF_ORIG_NP - 1));
+  ivec3 i0 = min(ivec3(c), ivec3(BF_ORIG_NH - 2, BF_ORIG_ND - 2, BF_ORIG_NP - 2));
+  vec3 a = c - vec3(i0);
+  vec3 acc = vec3(0.0);
+  for (int q = 0; q < 8; ++q) {
+    ivec3 o = ivec3(q % 2, (q / 2) % 2, q / 4);
+    float w = (o.x == 1 ? a.x : 1.0 - a.x) * (o.y == 1 ? a.y : 1.0 - a.y) * (o.z == 1 ? a.z : 1.0 - a.z);
+    ivec3 t = i0 + o;
+    acc += w * texelFetch(bf_orig, ivec2(t.z + BF_ORIG_NP * t.y, t.x), 0).rgb;
+  }
+  return acc;
+}
+vec3 bf_eval(vec3 wi, vec3 wo) {
+  if (u_which == 1) return brdf_factor_eval(wi, wo);
+  return BF_ORIG_KIND == 1 ? bf_orig_iso(wi, wo) : bf_orig_eval(wi, wo);
+}
+
+void main() {
+  vec2 f = gl_FragCoord.xy;
+  // Pixel (x, y), y = 0 at the top, as the CPU render (DESIGN.md 5.4).
+  float px = -1.0 + 2.0 * f.x / u_size.x;
+  float py = 1.0 - 2.0 * (u_size.y - f.y) / u_size.y;
+  if (u_mode == 0) {
+    float rr = px * px + py * py;
+    if (rr >= 1.0) { o_color = vec4(0.0); return; }
+    vec3 n = u_cam * vec3(px, py, sqrt(1.0 - rr));
+    vec3 wo_w = u_cam * vec3(0.0, 0.0, 1.0);
+    vec3 t = vec3(1.0, 0.0, 0.0) - n.x * n;
+    if (length(t) < 1e-9) t = vec3(0.0, 1.0, 0.0) - n.y * n;
+    t = normalize(t);
+    vec3 b = cross(n, t);
+    vec3 tl = u_light - n;
+    float d2 = dot(tl, tl);
+    vec3 wiw = tl / sqrt(d2);
+    float ci = dot(wiw, n);
+    vec3 wi = vec3(dot(wiw, t), dot(wiw, b), dot(wiw, n));
+    vec3 wo = vec3(dot(wo_w, t), dot(wo_w, b), dot(wo_w, n));
+    vec3 L = vec3(0.0);
+    if (u_env == 1) {
+      if (wo.z > 0.0) {
+        vec3 won = normalize(wo);
+        for (int k = 0; k < u_rule_n; ++k) {
+          vec4 node = texelFetch(bf_rule, ivec2(k, 0), 0);
+          vec3 sw = node.x * t + node.y * b + node.z * n;
+          L += node.w * node.z * bf_env_radiance(sw) * bf_eval(node.xyz, won);
+        }
+      }
+    } else if (ci > 0.0 && wo.z > 0.0) {
+      L = u_intensity * bf_eval(normalize(wi), normalize(wo)) * ci / d2;
+    }
+    o_color = vec4(L, 1.0);
+  } else if (u_mode == 1) {
+    // BRDF Explorer's image slice: theta_h along x, theta_d along y (up), phi_d fixed,
+    // phi_h = 0; wi = R_y(theta_h) d, wo = 2 (wi.h) h - wi.
+    float th = 0.5 * 3.14159265 * (f.x / u_size.x), td = 0.5 * 3.14159265 * (f.y / u_size.y);
+    vec3 h = vec3(sin(th), 0.0, cos(th));
+    vec3 d = vec3(sin(td) * cos(u_phi_d), sin(td) * sin(u_phi_d), cos(td));
+    vec3 wi = vec3(cos(th) * d.x + sin(th) * d.z, d.y, -sin(th) * d.x + cos(th) * d.z);
+    vec3 wo = 2.0 * dot(wi, h) * h - wi;
+    o_color = vec4(bf_eval(normalize(wi), normalize(wo)), 1.0);
+  } else {
+    // In-plane lobe: wi at theta_i in the x-z plane (phi = 0), wo at theta_o in
+    // [-90, 90] degrees along x (negative: the phi = 180 side).
+    float to = -0.5 * 3.14159265 + 3.14159265 * (f.x / u_size.x);
+    vec3 wi = vec3(sin(u_theta_i), 0.0, cos(u_theta_i));
+    vec3 wo = vec3(sin(to), 0.0, cos(to));
+    o_color = vec4(bf_eval(wi, wo), 1.0);
+  }
+}
+)GLSL";
+
+inline constexpr const char* kViewerScript = R"JS(
+(function () {
+"use strict";
+// viewer.js files are loaded when their run is shown (each is ~1 MB); the
+// test mode (#viewer-test) has them all written in by the loader script.
+const files = window.BF_VIEWER_FILES || [];
+const runs = window.BF_VIEWER = window.BF_VIEWER || {};
+const ids = files.map((f) => f.id);
+const root = document.getElementById("viewer");
+if (!root || ids.length === 0) return;
+const testMode = location.hash === "#viewer-test";
+const canvas = document.createElement("canvas");
+const gl = canvas.getContext("webgl2", {preserveDrawingBuffer: true});
+const status = document.getElementById("v-status");
+if (!gl) { status.textContent = "WebGL2 is not available in this browser: the viewer cannot run."; return; }
+if (!gl.getExtension("EXT_color_buffer_float")) { status.textContent = "EXT_color_buffer_float missing: the viewer cannot read float results."; return; }
+const VS = "#version 300 es\nvoid main(){vec2 p=vec2(float((gl_VertexID<<1)&2),float(gl_VertexID&2));gl_Position=vec4(p*2.0-1.0,0.0,1.0);}";
+const FS_MAIN = document.getElementById("v-shader-main").textContent;
+function b64floats(s) {
+  const bin = atob(s), n = bin.length, bytes = new Uint8Array(n);
+  for (let i = 0; i < n; ++i) bytes[i] = bin.charCodeAt(i);
+  return new Float32Array(bytes.buffer);
+}
+function compile(type, src) {
+  const s = gl.createShader(type);
+  gl.shaderSource(s, src);
+  gl.compileShader(s);
+  if (!gl.getShaderParameter(s, gl.COMPILE_STATUS)) throw new Error(gl.getShaderInfoLog(s));
+  return s;
+}
+function texture(w, h, data, rgba) {
+  const t = gl.createTexture();
+  gl.bindTexture(gl.TEXTURE_2D, t);
+  gl.pixelStorei(gl.UNPACK_ALIGNMENT, 1);
+  if (rgba) gl.texImage2D(gl.TEXTURE_2D, 0, gl.RGBA32F, w, h, 0, gl.RGBA, gl.FLOAT, data);
+  else gl.texImage2D(gl.TEXTURE_2D, 0, gl.RGB32F, w, h, 0, gl.RGB, gl.FLOAT, data);
+  for (const p of [gl.TEXTURE_MIN_FILTER, gl.TEXTURE_MAG_FILTER]) gl.texParameteri(gl.TEXTURE_2D, p, gl.NEAREST);
+  for (const p of [gl.TEXTURE_WRAP_S, gl.TEXTURE_WRAP_T]) gl.texParameteri(gl.TEXTURE_2D, p, gl.CLAMP_TO_EDGE);
+  return t;
+}
+const cache = {};
+function setup(id) {
+  if (cache[id]) return cache[id];
+  const r = runs[id];
+  const fs = "#version 300 es\n#define BRDF_FACTOR_EXACT_BILINEAR\nprecision highp float;\nprecision highp int;\n" +
+             r.glsl + "\nconst int BF_ORIG_RES = " + (r.original.res || 2) + ";\nconst int BF_ORIG_KIND = " +
+             (r.original.kind === "iso" ? 1 : 0) + ";\nconst int BF_ORIG_NH = " + (r.original.nh || 2) +
+             ", BF_ORIG_ND = " + (r.original.nd || 2) + ", BF_ORIG_NP = " + (r.original.np || 2) + ";\n" + FS_MAIN;
+  const prog = gl.createProgram();
+  gl.attachShader(prog, compile(gl.VERTEX_SHADER, VS));
+  gl.attachShader(prog, compile(gl.FRAGMENT_SHADER, fs));
+  gl.linkProgram(prog);
+  if (!gl.getProgramParameter(prog, gl.LINK_STATUS)) throw new Error(gl.getProgramInfoLog(prog));
+  const units = [];
+  r.textures.forEach((t, k) => { units.push({name: t.sampler, tex: texture(t.width, t.height, b64floats(t.data)), values: null}); });
+  const o = r.original;
+  units.push({name: "bf_orig", tex: o.kind === "iso" ? texture(o.np * o.nd, o.nh, b64floats(o.data))
+                                                    : texture(o.res * o.res, o.res * o.res, b64floats(o.data))});
+  const e = r.environment;
+  units.push({name: "bf_env", tex: e ? texture(e.width, e.height, b64floats(e.data)) : texture(2, 2, new Float32Array(12))});
+  units.push({name: "bf_rule", tex: e ? texture(e.nodes, 1, b64floats(e.rule), true) : texture(1, 1, new Float32Array(4), true)});
+  cache[id] = {prog, units};
+  return cache[id];
+}
+// Renders one mode into a w x h float target; returns RGBA floats, row 0 = top.
+function run(id, mode, which, w, h, u) {
+  const s = setup(id), r = runs[id];
+  const fb = gl.createFramebuffer(), rb = gl.createRenderbuffer();
+  gl.bindRenderbuffer(gl.RENDERBUFFER, rb);
+  gl.renderbufferStorage(gl.RENDERBUFFER, gl.RGBA32F, w, h);
+  gl.bindFramebuffer(gl.FRAMEBUFFER, fb);
+  gl.framebufferRenderbuffer(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.RENDERBUFFER, rb);
+  gl.viewport(0, 0, w, h);
+  gl.useProgram(s.prog);
+  s.units.forEach((t, k) => {
+    gl.activeTexture(gl.TEXTURE0 + k);
+    gl.bindTexture(gl.TEXTURE_2D, t.tex);
+    gl.uniform1i(gl.getUniformLocation(s.prog, t.name), k);
+  });
+  const L = (n) => gl.getUniformLocation(s.prog, n);
+  gl.uniform1i(L("u_mode"), mode);
+  gl.uniform1i(L("u_which"), which);
+  gl.uniform2f(L("u_size"), w, h);
+  gl.uniform3fv(L("u_light"), u.light);
+  gl.uniform1f(L("u_intensity"), r.scene.intensity);
+  gl.uniformMatrix3fv(L("u_cam"), false, u.cam);
+  gl.uniform1f(L("u_theta_i"), u.theta_i);
+  gl.uniform1f(L("u_phi_d"), u.phi_d);
+  gl.uniform1i(L("u_env"), u.env && r.environment ? 1 : 0);
+  gl.uniform1i(L("u_rule_n"), r.environment ? r.environment.nodes : 0);
+  gl.drawArrays(gl.TRIANGLES, 0, 3);
+  const px = new Float32Array(w * h * 4);
+  gl.readPixels(0, 0, w, h, gl.RGBA, gl.FLOAT, px);
+  gl.bindFramebuffer(gl.FRAMEBUFFER, null);
+  gl.deleteFramebuffer(fb);
+  gl.deleteRenderbuffer(rb);
+  const out = new Float32Array(w * h * 4);
+  for (let y = 0; y < h; ++y) out.set(px.subarray((h - 1 - y) * w * 4, (h - y) * w * 4), y * w * 4);
+  return out;
+}
+function srgb(v) { v = Math.min(1, Math.max(0, v)); return v <= 0.0031308 ? 12.92 * v : 1.055 * Math.pow(v, 1 / 2.4) - 0.055; }
+const STOPS = [[0, 0, 0], [0.1, 0.15, 0.85], [0.9, 0.1, 0.2], [1, 0.85, 0.1], [1, 1, 1]];
+function heat(t) {
+  t = Math.min(1, Math.max(0, t)) * 4;
+  const i = Math.min(3, Math.floor(t)), u = t - i;
+  return STOPS[i].map((a, c) => a * (1 - u) + STOPS[i + 1][c] * u);
+}
+function fmt(v) { return Math.abs(v) >= 1e4 || (Math.abs(v) < 1e-3 && v !== 0) ? v.toExponential(1) : (+v.toPrecision(3)).toString(); }
+function put(cv, w, h, colour) {
+  cv.width = w; cv.height = h;
+  const ctx = cv.getContext("2d"), img = ctx.createImageData(w, h);
+  for (let k = 0; k < w * h; ++k) {
+    const c = colour(k);
+    img.data[4 * k] = Math.round(255 * c[0]); img.data[4 * k + 1] = Math.round(255 * c[1]);
+    img.data[4 * k + 2] = Math.round(255 * c[2]); img.data[4 * k + 3] = 255;
+  }
+  ctx.putImageData(img, 0, 0);
+}
+// A horizontal colour bar with labelled ends and middle.
+function bar(cv, label, lo, hi, ramp, log) {
+  const w = 300, h = 44;
+  cv.width = w; cv.height = h;
+  const ctx = cv.getContext("2d");
+  for (let x = 0; x < w; ++x) {
+    const c = ramp(x / (w - 1));
+    ctx.fillStyle = "rgb(" + c.map((v) => Math.round(255 * v)).join(",") + ")";
+    ctx.fillRect(x, 0, 1, 14);
+  }
+  ctx.fillStyle = "#222"; ctx.font = "11px sans-serif";
+  const mid = log ? Math.sqrt(lo * hi) : 0.5 * (lo + hi);
+  ctx.textAlign = "left"; ctx.fillText(fmt(lo), 0, 26);
+  ctx.textAlign = "center"; ctx.fillText(fmt(mid), w / 2, 26);
+  ctx.textAlign = "right"; ctx.fillText(fmt(hi), w, 26);
+  ctx.textAlign = "center"; ctx.fillText(label, w / 2, 40);
+}
+const state = {id: null, light: null, cam: [1, 0, 0, 0, 1, 0, 0, 0, 1], yaw: 0, pitch: 0, exposure: 1,
+               theta_i: 30 * Math.PI / 180, phi_d: Math.PI / 2, env: true};
+const $ = (q) => document.getElementById(q);
+function camMatrix() {
+  const cy = Math.cos(state.yaw), sy = Math.sin(state.yaw), cp = Math.cos(state.pitch), sp = Math.sin(state.pitch);
+  // world = Ry(yaw) Rx(pitch) camera, column-major for uniformMatrix3fv.
+  return [cy, 0, -sy, sy * sp, cp, cy * sp, sy * cp, -sp, cy * cp];
+}
+function uniforms() { return {light: state.light, cam: state.cam, theta_i: state.theta_i, phi_d: state.phi_d, env: state.env}; }
+function draw() {
+  const id = state.id, r = runs[id], n = 160;
+  const u = uniforms();
+  let A, B;
+  try {
+    A = run(id, 0, 0, n, n, u);
+    B = run(id, 0, 1, n, n, u);
+  } catch (e) { status.textContent = "shader error: " + e.message; return; }
+  const expo = r.exposure * state.exposure;
+  const bg = [0.16, 0.16, 0.16];
+  put($("v-orig"), n, n, (k) => A[4 * k + 3] ? [0, 1, 2].map((c) => srgb(A[4 * k + c] * expo)) : bg);
+  put($("v-approx"), n, n, (k) => A[4 * k + 3] ? [0, 1, 2].map((c) => srgb(B[4 * k + c] * expo)) : bg);
+  put($("v-diff"), n, n, (k) => {
+    if (!A[4 * k + 3]) return bg;
+    let e = 0;
+    for (let c = 0; c < 3; ++c) e += Math.abs(B[4 * k + c] - A[4 * k + c]) / 3;
+    return heat(e * expo / 0.25);
+  });
+  bar($("v-bar-rad"), "radiance (white)", 0, 1 / expo, (t) => [srgb(t), srgb(t), srgb(t)], false);
+  bar($("v-bar-diff"), "|difference|", 0, 0.25 / expo, heat, false);
+  // theta_h - theta_d slices, log colour over 4 decades below the original's peak.
+  const m = 90;
+  const S0 = run(id, 1, 0, m, m, u), S1 = run(id, 1, 1, m, m, u);
+  let peak = 0;
+  for (let k = 0; k < m * m; ++k) peak = Math.max(peak, (S0[4 * k] + S0[4 * k + 1] + S0[4 * k + 2]) / 3);
+  peak = peak > 0 ? peak : 1;
+  const lo = peak * 1e-4;
+  const logc = (v) => heat((Math.log10(Math.max(v, lo)) - Math.log10(lo)) / 4);
+  put($("v-slice-orig"), m, m, (k) => logc((S0[4 * k] + S0[4 * k + 1] + S0[4 * k + 2]) / 3));
+  put($("v-slice-approx"), m, m, (k) => logc((S1[4 * k] + S1[4 * k + 1] + S1[4 * k + 2]) / 3));
+  bar($("v-bar-slice"), "f (1/sr, mean RGB, log)", lo, peak, (t) => heat(t), true);
+  // In-plane lobes, polar plot.
+  const N = 181, P0 = run(id, 2, 0, N, 1, u), P1 = run(id, 2, 1, N, 1, u);
+  const cv = $("v-lobe"), ctx = cv.getContext("2d"), W = cv.width, H = cv.height;
+  ctx.clearRect(0, 0, W, H);
+  let fmax = 0;
+  for (let k = 0; k < N; ++k) for (const P of [P0, P1]) fmax = Math.max(fmax, (P[4 * k] + P[4 * k + 1] + P[4 * k + 2]) / 3);
+  fmax = fmax > 0 ? fmax : 1;
+  const cx = W / 2, cy = H - 20, rad = Math.min(W / 2, H - 30) - 10;
+  ctx.strokeStyle = "#ccc"; ctx.beginPath(); ctx.arc(cx, cy, rad, Math.PI, 2 * Math.PI); ctx.stroke();
+  ctx.beginPath(); ctx.moveTo(cx, cy); ctx.lineTo(cx + rad * Math.sin(state.theta_i), cy - rad * Math.cos(state.theta_i)); ctx.stroke();
+  for (const [P, style, dash] of [[P0, "#1f77b4", []], [P1, "#d62728", [5, 3]]]) {
+    ctx.strokeStyle = style; ctx.setLineDash(dash); ctx.lineWidth = 1.5; ctx.beginPath();
+    for (let k = 0; k < N; ++k) {
+      const to = -Math.PI / 2 + Math.PI * (k + 0.5) / N, v = (P[4 * k] + P[4 * k + 1] + P[4 * k + 2]) / 3 / fmax;
+      const x = cx + rad * v * Math.sin(to), y = cy - rad * v * Math.cos(to);
+      if (k) ctx.lineTo(x, y); else ctx.moveTo(x, y);
+    }
+    ctx.stroke();
+  }
+  ctx.setLineDash([]); ctx.fillStyle = "#222"; ctx.font = "11px sans-serif";
+  ctx.fillText("radius: f (mean RGB), full scale " + fmt(fmax) + " 1/sr; grey: light at " +
+               Math.round(state.theta_i * 180 / Math.PI) + " deg", 6, H - 4);
+  $("v-info").textContent = r.label + " (" + r.method + "), " +
+      (state.env && r.environment ? "lit by the scene's SH lighting (" + r.environment.nodes + " hemisphere nodes per pixel)"
+                                  : "point light (" + state.light.map((v) => v.toFixed(2)).join(", ") + ")") +
+      "), view yaw " + Math.round(state.yaw * 180 / Math.PI) + " pitch " + Math.round(state.pitch * 180 / Math.PI) + " deg";
+  // Factor textures with their value scale.
+  const tx = $("v-textures");
+  tx.textContent = "";
+  r.textures.forEach((t) => {
+    const d = b64floats(t.data);
+    let a = Number.MAX_VALUE, b = -Number.MAX_VALUE;
+    for (let k = 0; k < t.width * t.height; ++k) { const v = (d[3 * k] + d[3 * k + 1] + d[3 * k + 2]) / 3; if (v !== 0) { a = Math.min(a, v); b = Math.max(b, v); } }
+    if (!(a < b)) { a = 0; b = 1; }
+    const fig = document.createElement("figure"), c1 = document.createElement("canvas"), c2 = document.createElement("canvas");
+    put(c1, t.width, t.height, (k) => heat(((d[3 * k] + d[3 * k + 1] + d[3 * k + 2]) / 3 - a) / (b - a)));
+    c1.style.width = Math.min(512, Math.max(128, t.width * 4)) + "px";
+    c1.style.imageRendering = "pixelated";
+    bar(c2, t.sampler + " (mean RGB)", a, b, heat, false);
+    fig.appendChild(c1); fig.appendChild(document.createElement("br")); fig.appendChild(c2);
+    tx.appendChild(fig);
+  });
+}
+// Controls.
+const sel = $("v-run");
+files.forEach((f) => { const o = document.createElement("option"); o.value = f.id; o.textContent = f.id + "  " + f.label; sel.appendChild(o); });
+function ensure(id, then) {
+  if (runs[id]) { then(); return; }
+  const f = files.find((x) => x.id === id);
+  status.textContent = "loading " + f.path + " ...";
+  const el = document.createElement("script");
+  el.onload = () => { if (runs[id]) then(); else status.textContent = f.path + " did not define run " + id; };
+  el.onerror = () => { status.textContent = "cannot load " + f.path; };
+  el.src = f.path;
+  document.body.appendChild(el);
+}
+function show(id) {
+  ensure(id, () => {
+    state.id = id;
+    sel.value = id;
+    state.light = runs[id].scene.light.slice();
+    $("v-env").disabled = !runs[id].environment;
+    draw();
+    status.textContent = "";
+  });
+}
+sel.onchange = () => show(sel.value);
+$("v-env").onchange = (e) => { state.env = e.target.checked; draw(); };
+$("v-exposure").oninput = (e) => { state.exposure = Math.pow(2, +e.target.value); draw(); };
+$("v-theta").oninput = (e) => { state.theta_i = +e.target.value * Math.PI / 180; draw(); };
+$("v-reset").onclick = () => { state.light = runs[state.id].scene.light.slice(); state.yaw = state.pitch = 0; state.cam = camMatrix(); draw(); };
+for (const pid of ["v-orig", "v-approx", "v-diff"]) {
+  const cv = $(pid);
+  let down = false;
+  const move = (e) => {
+    const b = cv.getBoundingClientRect();
+    const x = 2 * (e.clientX - b.left) / b.width - 1, y = 1 - 2 * (e.clientY - b.top) / b.height;
+    if (e.shiftKey) {
+      state.yaw = x * Math.PI / 2; state.pitch = -y * Math.PI / 2; state.cam = camMatrix();
+    } else {
+      const d = Math.hypot(...runs[state.id].scene.light), rr = Math.min(1, x * x + y * y);
+      const v = [x, y, Math.sqrt(1 - rr)], c = state.cam;
+      state.light = [0, 1, 2].map((i) => d * (c[i] * v[0] + c[3 + i] * v[1] + c[6 + i] * v[2]));
+    }
+    draw();
+  };
+  cv.onpointerdown = (e) => { down = true; move(e); };
+  cv.onpointermove = (e) => { if (down) move(e); };
+  window.addEventListener("pointerup", () => { down = false; });
+}
+if (testMode) {
+  // Numbers for the headless test: per run the sphere radiance of both BRDFs
+  // at the scene's size and light, and the approximation's slices.
+  const out = [];
+  for (const id of ids) {
+    const r = runs[id], n = r.scene.size, u = {light: r.scene.light, cam: [1, 0, 0, 0, 1, 0, 0, 0, 1], theta_i: 30 * Math.PI / 180, phi_d: Math.PI / 2};
+    const rec = {run: id, size: n};
+    try {
+      const pick = (a, w, h) => { const v = []; for (let k = 0; k < w * h; ++k) v.push(a[4 * k], a[4 * k + 1], a[4 * k + 2]); return v; };
+      rec.approx = pick(run(id, 0, 1, n, n, u), n, n);
+      rec.original = pick(run(id, 0, 0, n, n, u), n, n);
+      rec.slice = pick(run(id, 1, 1, 16, 16, u), 16, 16);
+      rec.lobe = pick(run(id, 2, 1, 32, 1, u), 32, 1);
+      rec.lobe_original = pick(run(id, 2, 0, 32, 1, u), 32, 1);
+      if (r.environment) {
+        const ue = Object.assign({}, u, {env: true});
+        rec.approx_env = pick(run(id, 0, 1, n, n, ue), n, n);
+      }
+    } catch (e) { rec.error = String(e.message || e); }
+    out.push(JSON.stringify(rec));
+  }
+  $("viewer-test").textContent = out.join("\n");
+}
+// "#viewer=<run_id>" opens that run and scrolls to the viewer.
+const wanted = location.hash.startsWith("#viewer=") ? location.hash.slice(8) : "";
+show(ids.includes(wanted) ? wanted : ids[0]);
+if (location.hash.startsWith("#viewer")) $("viewer-h").scrollIntoView();
+})();
+)JS";
+
+}  // namespace bf
