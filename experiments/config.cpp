@@ -230,6 +230,56 @@ bool is_measured(const Brdf& b) {
   return false;
 }
 
+// A [[brdf]] table's parameters: every key but preset, model, file and name.
+struct BrdfParams {
+  ParamDict params;
+  json values = json::object();               // hashed into the BRDF's identity
+  std::vector<std::string> label_parts;       // "k=v" for the label
+  std::map<std::string, std::string> where;   // key -> file:line
+};
+
+void read_brdf_params(Reader& r, const Combo& c, BrdfParams& bp) {
+  for (const auto& [k, n] : c) {
+    if (k == "preset" || k == "model" || k == "file" || k == "name") continue;
+    r.take(k);
+    bp.where[k] = r.ctx().where(*n);
+    if (auto v = n->as_integer()) {
+      bp.params.set_numbers(k, {static_cast<double>(v->get())});
+      bp.values[k] = v->get();
+      bp.label_parts.push_back(k + "=" + std::to_string(v->get()));
+    } else if (auto f = n->as_floating_point()) {
+      if (!std::isfinite(f->get())) {
+        r.fail(k, "expected a finite number, found " + fmt_num(f->get()));
+        continue;
+      }
+      bp.params.set_numbers(k, {f->get()});
+      bp.values[k] = f->get();
+      bp.label_parts.push_back(k + "=" + fmt_num(f->get()));
+    } else if (auto s = n->as_string()) {
+      bp.params.set_string(k, s->get());
+      bp.values[k] = s->get();
+      bp.label_parts.push_back(k + "=" + s->get());
+    } else if (auto a = n->as_array(); a && brdf_array_is_value(k, *a)) {
+      std::vector<double> xs;
+      std::string txt;
+      for (const auto& e : *a) {
+        xs.push_back(e.value<double>().value_or(0.0));
+        txt += (txt.empty() ? "" : "/") + fmt_num(xs.back());
+      }
+      if (xs.size() != 1 && xs.size() != 3) {
+        r.fail(k, "expected one number or three (r, g, b), found " + std::to_string(xs.size()) +
+                      " (to sweep a parameter write " + k + " = { sweep = [...] })");
+        continue;
+      }
+      bp.params.set_numbers(k, xs);
+      bp.values[k] = xs;
+      bp.label_parts.push_back(k + "=" + txt);
+    } else {
+      r.fail(k, "expected a number, three numbers or a word (a BRDF parameter), " + found(*n));
+    }
+  }
+}
+
 void read_brdfs(const toml::node* node, Ctx& ctx, std::vector<BrdfVariant>& out) {
   if (!node) {
     ctx.issue(ctx.path, "brdf", "missing: the config needs at least one [[brdf]] table "
@@ -293,49 +343,8 @@ void read_brdfs(const toml::node* node, Ctx& ctx, std::vector<BrdfVariant>& out)
         continue;
       }
       // Parameters: every other key.
-      ParamDict params(r.table_where() + ": " + section);
-      json pj = json::object();
-      std::vector<std::string> label_parts;
-      std::map<std::string, std::string> param_where;
-      for (const auto& [k, n] : c) {
-        if (k == "preset" || k == "model" || k == "file" || k == "name") continue;
-        r.take(k);
-        param_where[k] = ctx.where(*n);
-        if (auto v = n->as_integer()) {
-          params.set_numbers(k, {static_cast<double>(v->get())});
-          pj[k] = v->get();
-          label_parts.push_back(k + "=" + std::to_string(v->get()));
-        } else if (auto f = n->as_floating_point()) {
-          if (!std::isfinite(f->get())) {
-            r.fail(k, "expected a finite number, found " + fmt_num(f->get()));
-            continue;
-          }
-          params.set_numbers(k, {f->get()});
-          pj[k] = f->get();
-          label_parts.push_back(k + "=" + fmt_num(f->get()));
-        } else if (auto s = n->as_string()) {
-          params.set_string(k, s->get());
-          pj[k] = s->get();
-          label_parts.push_back(k + "=" + s->get());
-        } else if (auto a = n->as_array(); a && brdf_array_is_value(k, *a)) {
-          std::vector<double> xs;
-          std::string txt;
-          for (const auto& e : *a) {
-            xs.push_back(e.value<double>().value_or(0.0));
-            txt += (txt.empty() ? "" : "/") + fmt_num(xs.back());
-          }
-          if (xs.size() != 1 && xs.size() != 3) {
-            r.fail(k, "expected one number or three (r, g, b), found " + std::to_string(xs.size()) +
-                          " (to sweep a parameter write " + k + " = { sweep = [...] })");
-            continue;
-          }
-          params.set_numbers(k, xs);
-          pj[k] = xs;
-          label_parts.push_back(k + "=" + txt);
-        } else {
-          r.fail(k, "expected a number, three numbers or a word (a BRDF parameter), " + found(*n));
-        }
-      }
+      BrdfParams bp{ParamDict(r.table_where() + ": " + section)};
+      read_brdf_params(r, c, bp);
       if (r.failed()) continue;
       BrdfVariant b;
       b.where = r.table_where();
@@ -352,14 +361,14 @@ void read_brdfs(const toml::node* node, Ctx& ctx, std::vector<BrdfVariant>& out)
                                join(Catalogue::global().loader_extensions()) + ")");
             continue;
           }
-          b.brdf = Catalogue::global().load_file(resolved, params);
+          b.brdf = Catalogue::global().load_file(resolved, bp.params);
           b.identity = {{"file", fs::path(src).filename().string()},
                         {"digest", file_hash(resolved)},
-                        {"options", pj}};
+                        {"options", bp.values}};
           b.label = name.empty() ? src : name;
         } else {
-          b.brdf = Catalogue::global().make(src, params);
-          b.identity = {{src_key, src}, {"params", pj}, {"eval", b.brdf->to_string()}};
+          b.brdf = Catalogue::global().make(src, bp.params);
+          b.identity = {{src_key, src}, {"params", bp.values}, {"eval", b.brdf->to_string()}};
           b.label = name.empty() ? src : name;
         }
       } catch (const std::exception& e) {
@@ -367,7 +376,7 @@ void read_brdfs(const toml::node* node, Ctx& ctx, std::vector<BrdfVariant>& out)
         std::string msg = e.what();
         const std::string prefix = r.table_where() + ": " + section;
         std::string where = r.table_where(), field = section;
-        for (const auto& [k, w] : param_where)
+        for (const auto& [k, w] : bp.where)
           if (msg.find("'" + k + "'") != std::string::npos) {
             where = w;
             field = section + "." + k;
@@ -378,7 +387,7 @@ void read_brdfs(const toml::node* node, Ctx& ctx, std::vector<BrdfVariant>& out)
         ctx.issue(where, field, msg);
         continue;
       }
-      if (name.empty() && !label_parts.empty()) b.label += ":" + join(label_parts, ",");
+      if (name.empty() && !bp.label_parts.empty()) b.label += ":" + join(bp.label_parts, ",");
       b.measured = is_measured(*b.brdf);
       if (!seen_ids.insert(short_hash(b.identity)).second) continue;  // same BRDF twice
       out.push_back(std::move(b));

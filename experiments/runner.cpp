@@ -17,19 +17,15 @@
 #include <thread>
 #include <unistd.h>
 
-#include "brdfs/sample_csv.h"
 #include "brdfs/sampleset.h"
 #include "experiments/cli_util.h"
 #include "experiments/render.h"
+#include "experiments/sample_cache.h"
 #include "experiments/preflight.h"
 #include "experiments/methods/method_kind.h"
 #include "factor/isotropy.h"
 #include "factor/metrics.h"
 #include "solvers/parallel.h"
-#if __has_include("brdfs/measured.h")
-#include "brdfs/measured.h"
-#define BF_HAVE_MEASURED 1
-#endif
 
 namespace bf {
 
@@ -48,97 +44,6 @@ std::string hms(double s) {
   if (t >= 3600) std::snprintf(buf, sizeof buf, "%ld:%02ld:%02ld", t / 3600, (t / 60) % 60, t % 60);
   else std::snprintf(buf, sizeof buf, "%ld:%02ld", t / 60, t % 60);
   return buf;
-}
-
-// ------------------------------------------------------------------ sample cache
-
-// Binary sample cache: magic, count, flags, then the arrays. Any mismatch on
-// reading (size, magic, counts) makes the cache entry unusable (resampled).
-constexpr char kSampleMagic[8] = {'B', 'F', 'S', 'A', 'M', 'P', '0', '1'};
-
-void write_samples_bin(const SampleSet& s, const std::string& path) {
-  write_file_atomic(path, [&](std::ostream& o) {
-    auto put64 = [&](uint64_t v) { o.write(reinterpret_cast<const char*>(&v), sizeof v); };
-    o.write(kSampleMagic, 8);
-    const uint64_t n = s.size();
-    put64(n);
-    put64(s.weight.empty() ? 0 : 1);
-    put64(s.invalid_value);
-    put64(s.invalid_horizon);
-    put64(s.invalid_weight);
-    put64(s.description.size());
-    o.write(s.description.data(), static_cast<std::streamsize>(s.description.size()));
-    for (const auto* arr : {&s.wi, &s.wo})
-      for (const Vec3& v : *arr) o.write(reinterpret_cast<const char*>(v.data()), 3 * sizeof(double));
-    for (const Rgb& v : s.value) o.write(reinterpret_cast<const char*>(v.data()), 3 * sizeof(double));
-    if (!s.weight.empty()) o.write(reinterpret_cast<const char*>(s.weight.data()), n * sizeof(double));
-    o.write(reinterpret_cast<const char*>(s.valid.data()), static_cast<std::streamsize>(n));
-  });
-}
-
-bool read_samples_bin(const std::string& path, SampleSet& s) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return false;
-  std::error_code ec;
-  const uint64_t file_size = fs::file_size(path, ec);
-  if (ec) return false;
-  char magic[8];
-  if (!in.read(magic, 8) || std::memcmp(magic, kSampleMagic, 8) != 0) return false;
-  uint64_t h[6];
-  if (!in.read(reinterpret_cast<char*>(h), sizeof h)) return false;
-  const uint64_t n = h[0], has_w = h[1], dlen = h[5];
-  if (n > 200'000'000 || has_w > 1 || dlen > 1'000'000) return false;
-  const uint64_t expect = 8 + sizeof h + dlen + n * (9 * sizeof(double) + (has_w ? sizeof(double) : 0) + 1);
-  if (expect != file_size) return false;
-  s = SampleSet{};
-  s.description.resize(dlen);
-  in.read(s.description.data(), static_cast<std::streamsize>(dlen));
-  s.wi.resize(n);
-  s.wo.resize(n);
-  s.value.resize(n);
-  for (auto* arr : {&s.wi, &s.wo})
-    for (Vec3& v : *arr) in.read(reinterpret_cast<char*>(v.data()), 3 * sizeof(double));
-  for (Rgb& v : s.value) in.read(reinterpret_cast<char*>(v.data()), 3 * sizeof(double));
-  if (has_w) {
-    s.weight.resize(n);
-    in.read(reinterpret_cast<char*>(s.weight.data()), n * sizeof(double));
-  }
-  s.valid.resize(n);
-  in.read(reinterpret_cast<char*>(s.valid.data()), static_cast<std::streamsize>(n));
-  if (!in) return false;
-  s.invalid_value = h[2];
-  s.invalid_horizon = h[3];
-  s.invalid_weight = h[4];
-  return true;
-}
-
-std::shared_ptr<const SampleSet> make_samples(const Plan& plan, const PlannedRun& r, const fs::path& cache_dir,
-                                              bool force, bool* from_cache) {
-  const BrdfVariant& b = plan.brdfs[r.brdf];
-  const SamplingVariant& s = plan.samplings[r.sampling];
-  *from_cache = false;
-  auto out = std::make_shared<SampleSet>();
-  if (s.kind == "file") {
-    *out = read_sample_csv(s.path);
-    return out;
-  }
-  if (s.kind == "measured") {
-#ifdef BF_HAVE_MEASURED
-    *out = measured_samples(*b.brdf);
-    return out;
-#else
-    throw std::invalid_argument("sampling: measured samples are not available in this build");
-#endif
-  }
-  const fs::path path = cache_dir / (r.samples_key + ".bin");
-  if (!force && read_samples_bin(path.string(), *out)) {
-    *from_cache = true;
-    return out;
-  }
-  if (s.kind == "grid") *out = sample_grid(*b.brdf, s.resolution);
-  else *out = sample_stratified(*b.brdf, s.count, s.seed);
-  write_samples_bin(*out, path.string());
-  return out;
 }
 
 // ------------------------------------------------------------------ one run
@@ -397,154 +302,12 @@ void print_results(std::ostream& out, const OutputFiles& f) {
   out << "report:  " << f.report << "\n";
 }
 
-}  // namespace
-
-void parse_shard(const std::string& text, int& k, int& n) {
-  const auto slash = text.find('/');
-  auto bad = [&] {
-    return std::invalid_argument("--shard: expected K/N with 1 <= K <= N (e.g. 2/8), found '" + text + "'");
-  };
-  if (slash == std::string::npos) throw bad();
-  const std::string a = text.substr(0, slash), b = text.substr(slash + 1);
-  if (a.empty() || b.empty() || a.find_first_not_of("0123456789") != std::string::npos ||
-      b.find_first_not_of("0123456789") != std::string::npos || a.size() > 6 || b.size() > 6)
-    throw bad();
-  k = std::stoi(a);
-  n = std::stoi(b);
-  if (n < 1 || k < 1 || k > n) throw bad();
-}
-
-json build_identity(const json& versions) {
-  json b = {{"brdf_factor", versions.value("brdf_factor", "")}};
-  if (versions.contains("git_commit")) {
-    b["git_commit"] = versions["git_commit"];
-    b["git_dirty"] = versions.value("git_dirty", false);
-  }
-  return b;
-}
-
-std::string cached_run_commit(const json& record) {
-  const auto it = record.find("build");
-  if (it == record.end() || !it->is_object()) return "";
-  const auto c = it->find("git_commit");
-  return c != it->end() && c->is_string() ? c->get<std::string>() : "";
-}
-
-RunSummary run_experiment(const RunOptions& opt, std::ostream& out, std::ostream& err) {
-  if (opt.shards < 1 || opt.shard < 1 || opt.shard > opt.shards)
-    throw std::invalid_argument("--shard: expected K/N with 1 <= K <= N, found " + std::to_string(opt.shard) + "/" +
-                                std::to_string(opt.shards));
-  const Plan plan = load_plan(opt.config, opt.defines);
-  RunSummary sum;
-  std::string dir = opt.out.empty() ? plan.experiment.out : opt.out;
-  if (opt.out.empty() && opt.shards > 1)
-    dir = (fs::path(dir) / ("shard-" + std::to_string(opt.shard) + "-of-" + std::to_string(opt.shards))).string();
-  sum.out_dir = dir;
-  sum.planned = plan.runs.size();
-  const fs::path exp_dir(dir);
-
-  // Decide what each run of this shard needs.
-  enum class Action { Run, Redo, Cached, Forced, OtherShard };
-  std::vector<Action> action(plan.runs.size());
-  std::vector<std::optional<RunEntry>> cached(plan.runs.size());
-  for (size_t i = 0; i < plan.runs.size(); ++i) {
-    const PlannedRun& r = plan.runs[i];
-    if (static_cast<int>(i % opt.shards) != opt.shard - 1) {
-      action[i] = Action::OtherShard;
-      continue;
-    }
-    sum.run_ids.push_back(r.run_id);
-    ++sum.in_shard;
-    cached[i] = load_done_run(exp_dir, r.run_id);
-    if (cached[i]) action[i] = opt.force ? Action::Forced : Action::Cached;
-    else action[i] = incomplete_folder(exp_dir, r.run_id) ? Action::Redo : Action::Run;
-  }
-  size_t n_run = 0, n_cached = 0, n_other = 0;
-  for (Action a : action) {
-    if (a == Action::Cached) ++n_cached;
-    else if (a == Action::OtherShard) ++n_other;
-    else ++n_run;
-  }
-
-  // The cache key is the config, not the code: say when reused runs come from
-  // another build (git commit of the source tree), so results that a fitter
-  // change would alter are not mixed in silently.
-  const json build = build_identity(software_versions());
-  std::set<std::string> other_commits;
-  for (size_t i = 0; i < plan.runs.size(); ++i) {
-    if (action[i] != Action::Cached) continue;
-    const std::string theirs = cached_run_commit(cached[i]->record);
-    if (build.contains("git_commit") && theirs != build["git_commit"].get<std::string>()) {
-      ++sum.cached_other_build;
-      other_commits.insert(theirs.empty() ? "unrecorded" : theirs);
-    }
-  }
-  if (sum.cached_other_build)
-    err << "brdf-factor: warning: " << sum.cached_other_build << " of " << n_cached
-        << " cached runs were made by another build (" << join(std::vector<std::string>(other_commits.begin(), other_commits.end()), ", ")
-        << "; this build " << build["git_commit"].get<std::string>()
-        << "): the cache does not see code changes, --force redoes them\n";
-
-  if (opt.dry_run) {
-    out << "experiment " << plan.experiment.name << ": " << plan.runs.size() << " runs (" << plan.brdfs.size()
-        << " brdf x " << plan.samplings.size() << " sampling x " << plan.methods.size() << " method variants";
-    if (plan.duplicates) out << "; " << plan.duplicates << " duplicate combinations kept once";
-    out << ") -> " << dir << "\n";
-    if (opt.shards > 1) out << "shard " << opt.shard << "/" << opt.shards << "\n";
-    static const char* names[] = {"run", "redo", "cached", "force", "other-shard"};
-    for (size_t i = 0; i < plan.runs.size(); ++i)
-      out << plan.runs[i].run_id << "  " << std::left << std::setw(11) << names[static_cast<int>(action[i])]
-          << " " << describe_run(plan, plan.runs[i]) << "\n";
-    out << "would run " << n_run << ", skip " << n_cached << " cached (--force redoes them) and " << n_other
-        << " of other shards\n";
-    return sum;
-  }
-
-  {  // Before any work: the folder is writable and has room (experiments/preflight.h).
-    std::vector<bool> todo_runs(plan.runs.size());
-    for (size_t i = 0; i < plan.runs.size(); ++i)
-      todo_runs[i] = action[i] != Action::Cached && action[i] != Action::OtherShard;
-    check_output_folder(dir, estimate_output_bytes(plan, todo_runs));
-  }
-  fs::create_directories(exp_dir / "runs");
-  const int jobs_cfg = opt.jobs >= 0 ? opt.jobs : plan.experiment.jobs;
-  const int jobs = hardware_threads(jobs_cfg);
-  if (!opt.quiet) {
-    err << "experiment " << plan.experiment.name << ": " << sum.in_shard << " runs";
-    if (opt.shards > 1) err << " in shard " << opt.shard << "/" << opt.shards << " (of " << plan.runs.size() << ")";
-    err << ": " << n_run << " to do, " << n_cached << " cached";
-    size_t redo = 0;
-    for (Action a : action) redo += a == Action::Redo;
-    if (redo) err << " (" << redo << " unfinished, redone)";
-    err << "; " << jobs << " job slot" << (jobs > 1 ? "s" : "") << " -> " << dir << "\n";
-  }
-
-  // Samples for the runs to do.
-  std::map<std::string, std::shared_ptr<const SampleSet>> samples;
-  const fs::path cache_dir = exp_dir / "cache" / "samples";
-  fs::create_directories(cache_dir);
-  for (size_t i = 0; i < plan.runs.size(); ++i) {
-    const PlannedRun& r = plan.runs[i];
-    if (action[i] == Action::Cached || action[i] == Action::OtherShard || samples.count(r.samples_key)) continue;
-    const auto t0 = Clock::now();
-    bool hit = false;
-    samples[r.samples_key] = make_samples(plan, r, cache_dir, opt.force, &hit);
-    if (!opt.quiet)
-      err << "samples: " << plan.brdfs[r.brdf].label << " | " << plan.samplings[r.sampling].label << ": "
-          << samples[r.samples_key]->summary() << (hit ? " (cached)" : "") << " in " << hms(since(t0)) << "\n";
-  }
-
-  // Execute.
-  std::vector<RunEntry> entries(plan.runs.size());
-  std::vector<size_t> todo;
-  for (size_t i = 0; i < plan.runs.size(); ++i) {
-    if (action[i] == Action::Cached) {
-      entries[i] = *cached[i];
-      set_presentation(entries[i].row, plan, plan.runs[i]);
-    } else if (action[i] != Action::OtherShard) {
-      todo.push_back(i);
-    }
-  }
+// Executes the runs `todo` (plan indices, plan order) on `jobs` slots: each
+// run holds min(jobs, its method's cores) slots (runner.h), progress on err.
+void execute_in_parallel(const Plan& plan, const std::vector<size_t>& todo, int jobs,
+                         const std::map<std::string, std::shared_ptr<const SampleSet>>& samples,
+                         const fs::path& exp_dir, const json& build, const RunOptions& opt, std::ostream& err,
+                         std::vector<RunEntry>& entries) {
   RenderCache renders;
   std::mutex mu;
   std::condition_variable cv;
@@ -615,6 +378,180 @@ RunSummary run_experiment(const RunOptions& opt, std::ostream& out, std::ostream
     for (int t = 0; t < n_threads; ++t) pool.emplace_back(worker);
     for (auto& t : pool) t.join();
   }
+}
+
+enum class Action { Run, Redo, Cached, Forced, OtherShard };
+
+// The cache key is the config, not the code: says when reused runs come from
+// another build (git commit of the source tree), so results that a fitter
+// change would alter are not mixed in silently.
+void warn_other_builds(const Plan& plan, const std::vector<Action>& action,
+                       const std::vector<std::optional<RunEntry>>& cached, const json& build, size_t n_cached,
+                       RunSummary& sum, std::ostream& err) {
+  std::set<std::string> other_commits;
+  for (size_t i = 0; i < plan.runs.size(); ++i) {
+    if (action[i] != Action::Cached) continue;
+    const std::string theirs = cached_run_commit(cached[i]->record);
+    if (build.contains("git_commit") && theirs != build["git_commit"].get<std::string>()) {
+      ++sum.cached_other_build;
+      other_commits.insert(theirs.empty() ? "unrecorded" : theirs);
+    }
+  }
+  if (sum.cached_other_build)
+    err << "brdf-factor: warning: " << sum.cached_other_build << " of " << n_cached
+        << " cached runs were made by another build (" << join(std::vector<std::string>(other_commits.begin(), other_commits.end()), ", ")
+        << "; this build " << build["git_commit"].get<std::string>()
+        << "): the cache does not see code changes, --force redoes them\n";
+}
+
+// The --dry-run listing: every run of the plan with what would happen to it.
+void print_dry_run(const Plan& plan, const std::vector<Action>& action, const std::string& dir,
+                   const RunOptions& opt, size_t n_run, size_t n_cached, size_t n_other, std::ostream& out) {
+  out << "experiment " << plan.experiment.name << ": " << plan.runs.size() << " runs (" << plan.brdfs.size()
+      << " brdf x " << plan.samplings.size() << " sampling x " << plan.methods.size() << " method variants";
+  if (plan.duplicates) out << "; " << plan.duplicates << " duplicate combinations kept once";
+  out << ") -> " << dir << "\n";
+  if (opt.shards > 1) out << "shard " << opt.shard << "/" << opt.shards << "\n";
+  static const char* names[] = {"run", "redo", "cached", "force", "other-shard"};
+  for (size_t i = 0; i < plan.runs.size(); ++i)
+    out << plan.runs[i].run_id << "  " << std::left << std::setw(11) << names[static_cast<int>(action[i])]
+        << " " << describe_run(plan, plan.runs[i]) << "\n";
+  out << "would run " << n_run << ", skip " << n_cached << " cached (--force redoes them) and " << n_other
+      << " of other shards\n";
+}
+
+// The samples of the runs to do, by sample key (cache/samples/ in the folder).
+std::map<std::string, std::shared_ptr<const SampleSet>> prepare_samples(const Plan& plan,
+                                                                        const std::vector<Action>& action,
+                                                                        const fs::path& exp_dir,
+                                                                        const RunOptions& opt, std::ostream& err) {
+  std::map<std::string, std::shared_ptr<const SampleSet>> samples;
+  const fs::path cache_dir = exp_dir / "cache" / "samples";
+  fs::create_directories(cache_dir);
+  for (size_t i = 0; i < plan.runs.size(); ++i) {
+    const PlannedRun& r = plan.runs[i];
+    if (action[i] == Action::Cached || action[i] == Action::OtherShard || samples.count(r.samples_key)) continue;
+    const auto t0 = Clock::now();
+    bool hit = false;
+    samples[r.samples_key] = make_samples(plan, r, cache_dir, opt.force, &hit);
+    if (!opt.quiet)
+      err << "samples: " << plan.brdfs[r.brdf].label << " | " << plan.samplings[r.sampling].label << ": "
+          << samples[r.samples_key]->summary() << (hit ? " (cached)" : "") << " in " << hms(since(t0)) << "\n";
+  }
+  return samples;
+}
+
+}  // namespace
+
+void parse_shard(const std::string& text, int& k, int& n) {
+  const auto slash = text.find('/');
+  auto bad = [&] {
+    return std::invalid_argument("--shard: expected K/N with 1 <= K <= N (e.g. 2/8), found '" + text + "'");
+  };
+  if (slash == std::string::npos) throw bad();
+  const std::string a = text.substr(0, slash), b = text.substr(slash + 1);
+  if (a.empty() || b.empty() || a.find_first_not_of("0123456789") != std::string::npos ||
+      b.find_first_not_of("0123456789") != std::string::npos || a.size() > 6 || b.size() > 6)
+    throw bad();
+  k = std::stoi(a);
+  n = std::stoi(b);
+  if (n < 1 || k < 1 || k > n) throw bad();
+}
+
+json build_identity(const json& versions) {
+  json b = {{"brdf_factor", versions.value("brdf_factor", "")}};
+  if (versions.contains("git_commit")) {
+    b["git_commit"] = versions["git_commit"];
+    b["git_dirty"] = versions.value("git_dirty", false);
+  }
+  return b;
+}
+
+std::string cached_run_commit(const json& record) {
+  const auto it = record.find("build");
+  if (it == record.end() || !it->is_object()) return "";
+  const auto c = it->find("git_commit");
+  return c != it->end() && c->is_string() ? c->get<std::string>() : "";
+}
+
+RunSummary run_experiment(const RunOptions& opt, std::ostream& out, std::ostream& err) {
+  if (opt.shards < 1 || opt.shard < 1 || opt.shard > opt.shards)
+    throw std::invalid_argument("--shard: expected K/N with 1 <= K <= N, found " + std::to_string(opt.shard) + "/" +
+                                std::to_string(opt.shards));
+  const Plan plan = load_plan(opt.config, opt.defines);
+  RunSummary sum;
+  std::string dir = opt.out.empty() ? plan.experiment.out : opt.out;
+  if (opt.out.empty() && opt.shards > 1)
+    dir = (fs::path(dir) / ("shard-" + std::to_string(opt.shard) + "-of-" + std::to_string(opt.shards))).string();
+  sum.out_dir = dir;
+  sum.planned = plan.runs.size();
+  const fs::path exp_dir(dir);
+
+  // Decide what each run of this shard needs.
+  std::vector<Action> action(plan.runs.size());
+  std::vector<std::optional<RunEntry>> cached(plan.runs.size());
+  for (size_t i = 0; i < plan.runs.size(); ++i) {
+    const PlannedRun& r = plan.runs[i];
+    if (static_cast<int>(i % opt.shards) != opt.shard - 1) {
+      action[i] = Action::OtherShard;
+      continue;
+    }
+    sum.run_ids.push_back(r.run_id);
+    ++sum.in_shard;
+    cached[i] = load_done_run(exp_dir, r.run_id);
+    if (cached[i]) action[i] = opt.force ? Action::Forced : Action::Cached;
+    else action[i] = incomplete_folder(exp_dir, r.run_id) ? Action::Redo : Action::Run;
+  }
+  size_t n_run = 0, n_cached = 0, n_other = 0;
+  for (Action a : action) {
+    if (a == Action::Cached) ++n_cached;
+    else if (a == Action::OtherShard) ++n_other;
+    else ++n_run;
+  }
+
+  const json build = build_identity(software_versions());
+  warn_other_builds(plan, action, cached, build, n_cached, sum, err);
+
+  if (opt.dry_run) {
+    print_dry_run(plan, action, dir, opt, n_run, n_cached, n_other, out);
+    return sum;
+  }
+
+  {  // Before any work: the folder is writable and has room (experiments/preflight.h).
+    std::vector<bool> todo_runs(plan.runs.size());
+    for (size_t i = 0; i < plan.runs.size(); ++i)
+      todo_runs[i] = action[i] != Action::Cached && action[i] != Action::OtherShard;
+    check_output_folder(dir, estimate_output_bytes(plan, todo_runs));
+  }
+  fs::create_directories(exp_dir / "runs");
+  const int jobs_cfg = opt.jobs >= 0 ? opt.jobs : plan.experiment.jobs;
+  const int jobs = hardware_threads(jobs_cfg);
+  if (!opt.quiet) {
+    err << "experiment " << plan.experiment.name << ": " << sum.in_shard << " runs";
+    if (opt.shards > 1) err << " in shard " << opt.shard << "/" << opt.shards << " (of " << plan.runs.size() << ")";
+    err << ": " << n_run << " to do, " << n_cached << " cached";
+    size_t redo = 0;
+    for (Action a : action) redo += a == Action::Redo;
+    if (redo) err << " (" << redo << " unfinished, redone)";
+    err << "; " << jobs << " job slot" << (jobs > 1 ? "s" : "") << " -> " << dir << "\n";
+  }
+
+  // Samples for the runs to do.
+  const auto samples = prepare_samples(plan, action, exp_dir, opt, err);
+
+  // Execute.
+  std::vector<RunEntry> entries(plan.runs.size());
+  std::vector<size_t> todo;
+  for (size_t i = 0; i < plan.runs.size(); ++i) {
+    if (action[i] == Action::Cached) {
+      entries[i] = *cached[i];
+      set_presentation(entries[i].row, plan, plan.runs[i]);
+    } else if (action[i] != Action::OtherShard) {
+      todo.push_back(i);
+    }
+  }
+  const auto start = Clock::now();
+  execute_in_parallel(plan, todo, jobs, samples, exp_dir, build, opt, err, entries);
 
   ExperimentOutput o = base_output(plan, dir, opt.shard, opt.shards);
   o.plots = opt.plots && plan.experiment.plots;
