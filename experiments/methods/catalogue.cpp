@@ -1,4 +1,5 @@
 // The method catalogue's registry and generated key tables (see method_kind.h).
+#include <algorithm>
 #include <mutex>
 #include <sstream>
 
@@ -61,6 +62,13 @@ void register_method_kind(std::shared_ptr<const MethodKind> kind) {
   registry().push_back(std::move(kind));
 }
 
+void unregister_method_kind(const std::string& name) {
+  std::lock_guard<std::mutex> lk(registry_mutex());
+  auto& kinds = registry();
+  kinds.erase(std::remove_if(kinds.begin(), kinds.end(), [&](const auto& k) { return k->name() == name; }),
+              kinds.end());
+}
+
 std::vector<std::string> refinable_kind_names() {
   std::vector<std::string> names;
   for (const auto& k : registry())
@@ -88,6 +96,9 @@ std::vector<std::string> method_keys(const MethodKind& kind) {
 
 std::string method_key_tables() {
   std::ostringstream o;
+  o << "#### Keys of every kind\n\n| key | type (default) | meaning |\n|---|---|---|\n";
+  for (const auto& k : common_method_keys()) o << "| `" << k.name << "` | " << k.type_cell() << " | " << k.doc << " |\n";
+  o << "\n";
   for (const auto& kind : registry()) {
     o << "#### `kind = \"" << kind->name() << "\"`\n\n" << kind->summary() << "\n\n";
     o << "| key | type (default) | meaning |\n|---|---|---|\n";

@@ -134,6 +134,9 @@ class FitKind final : public HomomorphicKind {
            "conjugate projection too).";
   }
   std::vector<KeySpec> keys() const override { return fit_kind_keys(); }
+  std::string example() const override {
+    return "projections = [{ name = \"wi\" }, { name = \"h\" }]\ntexture_size = 6\n";
+  }
   std::vector<std::string> described() const override {
     return {"terms", "texture_size", "parameterization", "reciprocity"};
   }

@@ -20,13 +20,14 @@ class McCoolKind final : public HomomorphicKind {
     std::vector<KeySpec> k = fit_keys(homomorphic_texture_key());
     const auto r = refine_keys();
     k.insert(k.end(), r.begin(), r.end());
-    k.push_back(int_key("terms", 2, 2, "2", "only 2: McCool's two textures"));
+    k.push_back(other_key("terms", "integer", "2", "only 2: McCool's two textures"));
     k.push_back(other_key("tolerance", "table", "",
                           "with `texture_size = \"auto\"`: the smallest resolution reaching the target"));
     k.push_back(other_key("texture_ladder", "list of integers", "[8, 12, 16, 24, 32]",
                           "the resolutions `texture_size = \"auto\"` tries, ascending"));
     return k;
   }
+  std::string example() const override { return "texture_size = 6\n"; }
   std::vector<std::string> described() const override { return {"texture_size"}; }
 
   void read(Reader& r, MethodVariant& m, nlohmann::json& o, uint64_t) const override {

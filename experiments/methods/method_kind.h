@@ -77,6 +77,10 @@ class MethodKind {
   // Results columns beyond the common ones that a successful run of this
   // kind fills (checked by the generic catalogue test).
   virtual std::vector<std::string> columns() const = 0;
+  // A small, fast [[method]] body of this kind (TOML lines after `kind = ...`)
+  // that runs on a 6^4 grid in well under a second: the catalogue test runs
+  // every kind through it.
+  virtual std::string example() const = 0;
   // Arrays that are one value of a key rather than a sweep (e.g. guesses).
   virtual bool array_is_value(const std::string& key, const toml::array& a) const {
     (void)key, (void)a;
@@ -113,6 +117,8 @@ const MethodKind* find_method_kind(const std::string& name);
 std::vector<std::string> method_kind_names();
 // Adds a kind (tests); throws std::invalid_argument for a name already taken.
 void register_method_kind(std::shared_ptr<const MethodKind> kind);
+// Removes a kind added by register_method_kind (tests; plans using it must be gone).
+void unregister_method_kind(const std::string& name);
 
 // Keys of every [[method]] table, whatever its kind: kind, label, refine, zip.
 const std::vector<KeySpec>& common_method_keys();

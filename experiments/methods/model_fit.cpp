@@ -61,6 +61,7 @@ class ModelFitKind final : public MethodKind {
   }
   std::vector<KeySpec> keys() const override { return model_fit_keys(); }
   bool seeded() const override { return true; }
+  std::string example() const override { return "model = \"blinn-phong\"\nstarts = 1\nmax_iterations = 5\nthreads = 1\n"; }
   std::vector<std::string> described() const override {
     return {"model", "metric", "anisotropic", "lobes", "starts", "seed"};
   }

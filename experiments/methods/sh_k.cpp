@@ -43,6 +43,7 @@ class ShkKind final : public MethodKind {
            "`cos_rmse`. Under SH scene lighting the lighting's band limit caps `order`.";
   }
   std::vector<KeySpec> keys() const override { return shk_keys(); }
+  std::string example() const override { return "order = 2\ntexture_size = 6\n"; }
   std::vector<std::string> described() const override { return {"order", "texture_size"}; }
   std::vector<std::string> columns() const override { return {"texture_size", "order"}; }
 

@@ -62,6 +62,7 @@ class ShrKind final : public MethodKind {
            "`max_order` and `order`.";
   }
   std::vector<KeySpec> keys() const override { return shr_keys(); }
+  std::string example() const override { return "order = 2\nview_order = 1\nmax_order = 4\nmax_view_order = 2\n"; }
   std::vector<std::string> described() const override { return {"order", "view_order"}; }
   std::vector<std::string> columns() const override { return {"order", "view_order"}; }
 

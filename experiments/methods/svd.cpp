@@ -56,6 +56,7 @@ class SvdKind final : public MethodKind {
            "channel (`factor/svd_baseline.h`).";
   }
   std::vector<KeySpec> keys() const override { return svd_keys(); }
+  std::string example() const override { return "terms = 2\ntexture_size = 6\n"; }
   std::vector<std::string> described() const override { return {"terms", "texture_size", "parameterization", "log"}; }
   std::vector<std::string> columns() const override {
     return {"parameterization", "terms", "texture_size", "negative_texels", "errors_after_term"};
