@@ -734,16 +734,18 @@ int read_texture_size(Reader& r, MethodVariant& m, json& o, int def, int lo, int
 }
 
 void report_invalid(Reader& r, const std::exception& e, const std::vector<std::string>& keys,
-                    const std::string& prefix) {
+                    const std::string& prefix, const std::map<std::string, std::string>& renames) {
   const auto* oe = dynamic_cast<const OptionError*>(&e);
-  if (!oe || !contains(keys, oe->field())) {
+  const auto renamed = oe ? renames.find(oe->field()) : renames.end();
+  const std::string key = !oe ? "" : renamed != renames.end() ? renamed->second : oe->field();
+  if (!oe || !contains(keys, key)) {
     r.fail_table(prefix + e.what());
     return;
   }
   std::string msg = e.what();
   const std::string lead = oe->field() + ": ";
   if (const size_t at = msg.find(lead); at != std::string::npos) msg = msg.substr(at + lead.size());
-  r.fail(oe->field(), msg);
+  r.fail(key, msg);
 }
 
 const std::vector<std::string>& tolerance_keys() {

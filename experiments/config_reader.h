@@ -149,8 +149,9 @@ class Reader {
 // Reports an options struct's validate() failure: an OptionError whose field
 // is one of `keys` at that key (its "field: " prefix dropped), anything else
 // at the table (with `prefix` before the message).
+// renames: option field -> config key where they differ (refine: blend_weight -> refine_blend).
 void report_invalid(Reader& r, const std::exception& e, const std::vector<std::string>& keys,
-                    const std::string& prefix = "");
+                    const std::string& prefix = "", const std::map<std::string, std::string>& renames = {});
 
 // Keys shared by several method kinds.
 Parameterization read_param(Reader& r, const std::string& key, Parameterization def);

@@ -1,5 +1,6 @@
 // Homomorphic least-squares fit (see homomorphic_fit.h for the formulation).
 #include "factor/homomorphic_fit.h"
+#include "solvers/option_error.h"
 
 #include <Eigen/Cholesky>
 #include <Eigen/QR>
@@ -15,12 +16,12 @@ namespace bf {
 
 void FitOptions::validate() const {
   if (!(eps > 0.0 && eps <= 1.0))
-    throw std::invalid_argument("eps: expected 0 < eps <= 1, found " + std::to_string(eps));
+    throw OptionError("eps", "eps: expected 0 < eps <= 1, found " + std::to_string(eps));
   if (!(smoothing >= 0.0) || !std::isfinite(smoothing))
-    throw std::invalid_argument("smoothing: expected a finite value >= 0, found " +
+    throw OptionError("smoothing", "smoothing: expected a finite value >= 0, found " +
                                 std::to_string(smoothing));
   if (solve_last < 1)
-    throw std::invalid_argument("solve_last: expected >= 1, found " + std::to_string(solve_last));
+    throw OptionError("solve_last", "solve_last: expected >= 1, found " + std::to_string(solve_last));
 }
 
 FitData::FitData(const SampleSet& s, double eps) {

@@ -555,8 +555,7 @@ void ModelFitOptions::validate() const {
   if (metric != "cosine" && metric != "log")
     throw OptionError("metric", "metric: expected cosine or log, found '" + metric + "'");
   if (cube_root && metric != "cosine")
-    throw OptionError("cube_root", "cube_root: applies only to metric = \"cosine\"; found metric = \"" +
-                                        metric + "\"");
+    throw OptionError("cube_root", "cube_root: applies only to metric = \"cosine\"; found metric = " + metric);
   if (!(eps > 0.0 && eps <= 1.0))
     throw OptionError("eps", "eps: expected 0 < eps <= 1, found " + std::to_string(eps));
   if (starts < 1 || starts > 1000)

@@ -1,5 +1,6 @@
 // Nonlinear refinement of homomorphic factorizations with Ceres (see refine.h).
 #include "factor/refine.h"
+#include "solvers/option_error.h"
 
 #include <ceres/ceres.h>
 
@@ -127,19 +128,19 @@ void choose_linear_solver(RefineOptions::LinearSolver which, ceres::Solver::Opti
 void RefineOptions::validate() const {
   parse_objective(objective);
   if (!(blend_weight >= 0.0) || !std::isfinite(blend_weight))
-    throw std::invalid_argument("blend_weight: expected a finite value >= 0, found " +
+    throw OptionError("blend_weight", "blend_weight: expected a finite value >= 0, found " +
                                 std::to_string(blend_weight));
   if (max_iterations < 1)
-    throw std::invalid_argument("max_iterations: expected >= 1, found " +
+    throw OptionError("max_iterations", "max_iterations: expected >= 1, found " +
                                 std::to_string(max_iterations));
   if (!(smoothing >= 0.0) || !std::isfinite(smoothing))
-    throw std::invalid_argument("smoothing: expected a finite value >= 0, found " +
+    throw OptionError("smoothing", "smoothing: expected a finite value >= 0, found " +
                                 std::to_string(smoothing));
   if (threads < 0)
-    throw std::invalid_argument("threads: expected >= 0 (0 = all hardware threads), found " +
+    throw OptionError("threads", "threads: expected >= 0 (0 = all hardware threads), found " +
                                 std::to_string(threads));
   if (!(function_tolerance > 0.0) || !std::isfinite(function_tolerance))
-    throw std::invalid_argument("function_tolerance: expected a finite value > 0, found " +
+    throw OptionError("function_tolerance", "function_tolerance: expected a finite value > 0, found " +
                                 std::to_string(function_tolerance));
 }
 

@@ -93,7 +93,7 @@ void validate_fit_options(Reader& r, const MethodVariant& m) {
   try {
     m.fit.validate();
   } catch (const std::exception& e) {
-    r.fail_table(e.what());
+    report_invalid(r, e, method_keys(*m.impl));
   }
 }
 
@@ -106,7 +106,9 @@ void finish_refine_options(Reader& r, MethodVariant& m, json& o) {
   try {
     ro.validate();
   } catch (const std::exception& e) {
-    r.fail_table(std::string("refinement: ") + e.what());
+    report_invalid(r, e, method_keys(*m.impl), "refinement: ",
+                   {{"blend_weight", "refine_blend"}, {"max_iterations", "refine_iterations"},
+                    {"smoothing", "refine_smoothing"}});
   }
 }
 

@@ -32,7 +32,7 @@ const std::vector<KeySpec>& search_keys() {
         num_key("ftol", 0.0, 1.0, true, "1e-3",
                 "relative improvement per sweep below which Powell stops (also nlopt's ftol)"),
         num_key("line_tol", 0.0, 10.0, true, "0.02", "golden-section bracket width (radians of t)"),
-        num_key("initial_step", 0.0, 10.0, true, "0.3", "first bracketing step"),
+        num_key("initial_step", 0.0, 6.28, true, "0.3", "first bracketing step (below 2π)"),
         int_key("max_sweeps", 1, 100000, "30", "Powell sweeps per minimization"),
         int_key("max_evaluations", 10, 100000000, "5000", "objective evaluations per minimization"),
         int_key("threads", 0, 1024, "0",
@@ -186,7 +186,7 @@ class SearchKind final : public HomomorphicKind {
       try {
         s.validate();
       } catch (const std::exception& e) {
-        r.fail_table(e.what());
+        report_invalid(r, e, method_keys(*this));
       }
     }
     finish_refine_options(r, m, o);

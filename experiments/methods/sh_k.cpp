@@ -73,7 +73,7 @@ class ShkKind final : public MethodKind {
       try {
         k.validate();
       } catch (const std::exception& e) {
-        r.fail_table(e.what());
+        report_invalid(r, e, method_keys(*this));
       }
     }
   }

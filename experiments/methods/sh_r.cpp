@@ -100,7 +100,7 @@ class ShrKind final : public MethodKind {
       try {
         s.validate();
       } catch (const std::exception& e) {
-        r.fail_table(e.what());
+        report_invalid(r, e, method_keys(*this));
       }
     }
   }

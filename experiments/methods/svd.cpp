@@ -93,7 +93,7 @@ class SvdKind final : public MethodKind {
       try {
         v.validate();
       } catch (const std::exception& e) {
-        r.fail_table(e.what());
+        report_invalid(r, e, method_keys(*this));
       }
     }
   }
