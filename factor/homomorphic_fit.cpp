@@ -568,4 +568,38 @@ std::vector<TermSpec> mccool_terms(int res) {
   return {p, q};
 }
 
+Eigen::MatrixXd joint_normal_matrix(const FitData& d, const std::vector<TermSpec>& joint, const FitOptions& opt,
+                                    size_t max_unknowns, size_t* unknowns) {
+  opt.validate();
+  if (joint.empty()) throw std::invalid_argument("fit: no terms to solve");
+  std::vector<TermLayout> terms;
+  std::vector<std::array<Lookups, 2>> own(joint.size());
+  std::vector<const std::array<Lookups, 2>*> lookups;
+  int M = 0;
+  for (size_t i = 0; i < joint.size(); ++i) {
+    add_layout(d, joint[i], M, terms, own[i]);
+    lookups.push_back(&own[i]);
+  }
+  if (unknowns) *unknowns = static_cast<size_t>(M);
+  if (static_cast<size_t>(M) > max_unknowns) return Eigen::MatrixXd();
+  Eigen::MatrixXd A = Eigen::MatrixXd::Zero(M, M), rhs = Eigen::MatrixXd::Zero(M, 3);
+  const std::array<std::vector<double>, 3> no_fixed{std::vector<double>(d.size(), 0.0),
+                                                    std::vector<double>(d.size(), 0.0),
+                                                    std::vector<double>(d.size(), 0.0)};
+  double sum_wr2[3];
+  assemble_dense(d, no_fixed, terms, lookups, 0, A, rhs, sum_wr2);
+  const double mu = opt.smoothing * d.W / std::max(M, 1);
+  for (const TermLayout& t : terms)
+    laplacian_rows(t, [&](const int* li, const double* lv, int n) {
+      for (int a = 0; a < n; ++a)
+        for (int b = 0; b < n; ++b)
+          if (li[a] >= li[b]) A(li[a], li[b]) += mu * lv[a] * lv[b];
+    });
+  const double mean_diag = A.diagonal().sum() / std::max(M, 1);
+  for (size_t t = 1; t < terms.size(); ++t)
+    A.block(terms[t].first, terms[t].first, terms[t].count, terms[t].count).triangularView<Eigen::Lower>() +=
+        Eigen::MatrixXd::Constant(terms[t].count, terms[t].count, mean_diag / terms[t].count);
+  return A.selfadjointView<Eigen::Lower>();
+}
+
 }  // namespace bf
