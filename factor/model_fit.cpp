@@ -21,6 +21,7 @@
 #include "brdfs/params.h"
 #include "factor/metrics.h"
 #include "solvers/option_error.h"
+#include "solvers/parallel.h"
 
 namespace bf {
 
@@ -676,9 +677,7 @@ ModelFitResult fit_model(const SampleSet& s, const ModelFitOptions& opt) {
   so.max_num_iterations = opt.max_iterations;
   so.function_tolerance = 1e-10;
   so.parameter_tolerance = 1e-10;
-  so.num_threads = opt.threads > 0
-                       ? opt.threads
-                       : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+  so.num_threads = hardware_threads(opt.threads);
   so.logging_type = ceres::SILENT;
 
   ModelFitResult res;

@@ -1,6 +1,7 @@
 // Nonlinear refinement of homomorphic factorizations with Ceres (see refine.h).
 #include "factor/refine.h"
 #include "solvers/option_error.h"
+#include "solvers/parallel.h"
 
 #include <ceres/ceres.h>
 
@@ -303,8 +304,7 @@ std::shared_ptr<HomomorphicFactorization> refine(const HomomorphicFactorization&
   choose_linear_solver(opt.linear_solver, so, solver_name);
   so.max_num_iterations = opt.max_iterations;
   so.function_tolerance = opt.function_tolerance;
-  so.num_threads = opt.threads > 0 ? opt.threads
-                                   : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+  so.num_threads = hardware_threads(opt.threads);
   so.logging_type = ceres::SILENT;
   so.minimizer_progress_to_stdout = false;
   ceres::Solver::Summary summary;

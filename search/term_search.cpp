@@ -1,6 +1,7 @@
 // Greedy projection search (see term_search.h).
 #include "search/term_search.h"
 #include "solvers/option_error.h"
+#include "solvers/parallel.h"
 
 #include <nlopt.hpp>
 
@@ -163,8 +164,7 @@ namespace {
 // Minimizes f from every start, in parallel (results independent of scheduling).
 std::vector<StartResult> run_starts(const RotationObjective& f, const std::vector<Rotation4>& starts,
                                     const SearchOptions& opt) {
-  const unsigned hw = std::max(1u, std::thread::hardware_concurrency());
-  const unsigned nthreads = opt.threads > 0 ? opt.threads : hw;
+  const unsigned nthreads = static_cast<unsigned>(hardware_threads(opt.threads));
   std::vector<StartResult> results(starts.size());
   std::atomic<size_t> next{0};
   auto worker = [&] {
