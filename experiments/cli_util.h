@@ -5,6 +5,7 @@
 #include <functional>
 #include <ostream>
 #include <string>
+#include <vector>
 
 #include "brdfs/brdf.h"
 
@@ -14,6 +15,9 @@ namespace bf {
 // option in messages ("--wi"). Throws std::invalid_argument on malformed input
 // or a zero vector. Non-unit input is normalized.
 Vec3 parse_direction(const std::string& text, const std::string& what);
+
+// The strings joined with sep between them.
+std::string join(const std::vector<std::string>& v, const std::string& sep = ", ");
 
 // Writes a file through a temporary next to it and renames it into place, so a
 // reader never sees a half-written file. Throws std::runtime_error naming the

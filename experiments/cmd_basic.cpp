@@ -8,13 +8,22 @@
 #include "brdfs/sampleset.h"
 #include "experiments/cli_util.h"
 #include "experiments/commands.h"
+#include "experiments/methods/method_kind.h"
 
 namespace bf {
 
 void add_cmd_list(CLI::App& app) {
   auto* cmd = app.add_subcommand("list", "List the catalogue: models with parameters and "
-                                         "defaults, presets, measured-file formats");
-  cmd->callback([] {
+                                         "defaults, presets, measured-file formats; `list methods`: "
+                                         "the method kinds and their keys (markdown)");
+  auto what = std::make_shared<std::string>();
+  cmd->add_option("what", *what, "methods: the key tables of every method kind")
+      ->check(CLI::IsMember({"methods"}));
+  cmd->callback([what] {
+    if (*what == "methods") {
+      std::cout << method_key_tables();
+      return;
+    }
     const Catalogue& cat = Catalogue::builtin();
     std::cout << "Models:\n";
     for (const auto& [name, m] : cat.models()) {

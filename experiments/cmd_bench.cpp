@@ -15,6 +15,7 @@
 #include "factor/homomorphic_fit.h"
 #include "search/rotation4.h"
 #include "search/term_search.h"
+#include "solvers/parallel.h"
 
 namespace bf {
 
@@ -189,7 +190,7 @@ void run_bench_search(const BenchSearchArgs& a) {
   j["terms"] = a.terms;
   j["restarts"] = a.restarts;
   j["optimizer"] = a.optimizer;
-  j["threads"] = a.threads > 0 ? a.threads : static_cast<int>(std::thread::hardware_concurrency());
+  j["threads"] = hardware_threads(a.threads);
   j["beam"] = a.beam;
   j["backfit_sweeps"] = a.backfit_sweeps;
   j["backfit_restarts"] = a.backfit_restarts;

@@ -4,6 +4,7 @@
 // content-hash run id.
 #pragma once
 
+#include <any>
 #include <cstdint>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -21,6 +22,8 @@
 #include "search/term_search.h"
 
 namespace bf {
+
+class MethodKind;  // experiments/methods/method_kind.h
 
 // Every problem found in a config, one line each, formatted
 // "<file>:<line>: <field>: <rule, expected, found>" (or "-D key=value: <field>: ..."
@@ -85,13 +88,18 @@ struct SamplingVariant {
   nlohmann::json identity;  // kind + parameters (+ file digest)
 };
 
+// One [[method]] variant. Its kind (experiments/methods/) reads and runs it;
+// only the kind looks at its typed options.
 struct MethodVariant {
-  std::string kind;         // "mccool" | "fit" | "search" | "svd" | "sh-k" | "sh-r" | "model-fit"
+  std::string kind;         // a registered kind's name (`brdf-factor list methods`)
+  const MethodKind* impl = nullptr;  // that kind
+
   std::string label;        // `label` key, default the kind
   std::string where;        // "file:line" of its [[method]] table
   nlohmann::json options;   // every effective option with its default filled in (hashed)
   nlohmann::json execution; // options that do not change results (threads): recorded, not hashed
-  // Typed options (those of the kind are meaningful).
+  // Typed options, filled by the kind's reader (those of the kind are
+  // meaningful). A kind with options of its own type keeps them in `extra`.
   int texture_size = 16;
   int terms = 2;
   Parameterization param = Parameterization::WiWo;
@@ -116,6 +124,7 @@ struct MethodVariant {
   std::vector<int> texture_ladder;
   uint64_t seed = 0;        // search seed (0 when the kind has none)
   int cores = 1;            // cores the method keeps busy by itself (scheduling, runner.h)
+  std::any extra;           // options of a kind that has no field above
 };
 
 struct PlannedRun {
@@ -150,8 +159,9 @@ Plan parse_plan(const std::string& text, const std::string& path,
                 const std::vector<std::string>& defines = {});
 
 // Keys of docs/experiments.md, per section ("experiment", "sampling", "scene",
-// "brdf" (reserved keys only), "projection") and per method kind ("method:search", ...).
-const std::vector<std::string>& config_keys(const std::string& section);
+// "brdf" (reserved keys only), "projection", "tolerance") and per method kind
+// ("method:search", ...: the common keys, then the kind's, from the catalogue).
+std::vector<std::string> config_keys(const std::string& section);
 
 // 64-bit FNV-1a of bytes as 16 hex digits.
 std::string content_hash(const std::string& bytes);

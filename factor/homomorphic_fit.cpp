@@ -1,5 +1,6 @@
 // Homomorphic least-squares fit (see homomorphic_fit.h for the formulation).
 #include "factor/homomorphic_fit.h"
+#include "solvers/option_error.h"
 
 #include <Eigen/Cholesky>
 #include <Eigen/QR>
@@ -15,12 +16,12 @@ namespace bf {
 
 void FitOptions::validate() const {
   if (!(eps > 0.0 && eps <= 1.0))
-    throw std::invalid_argument("eps: expected 0 < eps <= 1, found " + std::to_string(eps));
+    throw OptionError("eps", "eps: expected 0 < eps <= 1, found " + std::to_string(eps));
   if (!(smoothing >= 0.0) || !std::isfinite(smoothing))
-    throw std::invalid_argument("smoothing: expected a finite value >= 0, found " +
+    throw OptionError("smoothing", "smoothing: expected a finite value >= 0, found " +
                                 std::to_string(smoothing));
   if (solve_last < 1)
-    throw std::invalid_argument("solve_last: expected >= 1, found " + std::to_string(solve_last));
+    throw OptionError("solve_last", "solve_last: expected >= 1, found " + std::to_string(solve_last));
 }
 
 FitData::FitData(const SampleSet& s, double eps) {
@@ -565,6 +566,40 @@ std::vector<TermSpec> mccool_terms(int res) {
   TermSpec p{projection_first_pair(Parameterization::WiWo, res), true, std::nullopt};
   TermSpec q{projection_first_pair(Parameterization::HalfDiff, res), false, std::nullopt};
   return {p, q};
+}
+
+Eigen::MatrixXd joint_normal_matrix(const FitData& d, const std::vector<TermSpec>& joint, const FitOptions& opt,
+                                    size_t max_unknowns, size_t* unknowns) {
+  opt.validate();
+  if (joint.empty()) throw std::invalid_argument("fit: no terms to solve");
+  std::vector<TermLayout> terms;
+  std::vector<std::array<Lookups, 2>> own(joint.size());
+  std::vector<const std::array<Lookups, 2>*> lookups;
+  int M = 0;
+  for (size_t i = 0; i < joint.size(); ++i) {
+    add_layout(d, joint[i], M, terms, own[i]);
+    lookups.push_back(&own[i]);
+  }
+  if (unknowns) *unknowns = static_cast<size_t>(M);
+  if (static_cast<size_t>(M) > max_unknowns) return Eigen::MatrixXd();
+  Eigen::MatrixXd A = Eigen::MatrixXd::Zero(M, M), rhs = Eigen::MatrixXd::Zero(M, 3);
+  const std::array<std::vector<double>, 3> no_fixed{std::vector<double>(d.size(), 0.0),
+                                                    std::vector<double>(d.size(), 0.0),
+                                                    std::vector<double>(d.size(), 0.0)};
+  double sum_wr2[3];
+  assemble_dense(d, no_fixed, terms, lookups, 0, A, rhs, sum_wr2);
+  const double mu = opt.smoothing * d.W / std::max(M, 1);
+  for (const TermLayout& t : terms)
+    laplacian_rows(t, [&](const int* li, const double* lv, int n) {
+      for (int a = 0; a < n; ++a)
+        for (int b = 0; b < n; ++b)
+          if (li[a] >= li[b]) A(li[a], li[b]) += mu * lv[a] * lv[b];
+    });
+  const double mean_diag = A.diagonal().sum() / std::max(M, 1);
+  for (size_t t = 1; t < terms.size(); ++t)
+    A.block(terms[t].first, terms[t].first, terms[t].count, terms[t].count).triangularView<Eigen::Lower>() +=
+        Eigen::MatrixXd::Constant(terms[t].count, terms[t].count, mean_diag / terms[t].count);
+  return A.selfadjointView<Eigen::Lower>();
 }
 
 }  // namespace bf

@@ -133,6 +133,16 @@ std::shared_ptr<HomomorphicFactorization> fit_homomorphic(
     const FitData& d, const std::vector<TermSpec>& terms, const FitOptions& opt,
     const std::string& method = "fit", std::vector<double>* errors_after_term = nullptr);
 
+// The normal matrix solve_joint's dense path factors for `joint` alone (no
+// fixed terms): the data block B^T W B, mu L^T L and the gauge penalties, in
+// its unknown layout (each term's mask extended by every texel a sample
+// touches; terms in order), full symmetric, M x M. Without the 1e-12 ridge
+// solve_joint adds. For diagnostics (factor/stress.h: its condition number).
+// *unknowns receives M; above max_unknowns an empty matrix is returned
+// (nothing assembled). Throws std::invalid_argument as solve_joint does.
+Eigen::MatrixXd joint_normal_matrix(const FitData& d, const std::vector<TermSpec>& joint, const FitOptions& opt,
+                                    size_t max_unknowns, size_t* unknowns = nullptr);
+
 // McCool's fixed projections (thesis 2.1.1): p(wi) and p(wo) share one texture
 // (a reciprocal wiwo term), q(h) has its own (halfdiff, first pair; h through
 // the parabolic map). Two textures of size res.

@@ -15,10 +15,13 @@
 #include <stdexcept>
 #include <thread>
 
+#include "solvers/option_error.h"
 #include "brdfs/catalogue.h"
 #include "brdfs/models.h"
 #include "brdfs/params.h"
 #include "factor/metrics.h"
+#include "solvers/option_error.h"
+#include "solvers/parallel.h"
 
 namespace bf {
 
@@ -96,7 +99,7 @@ ModelSpec parse_model(const ModelFitOptions& opt) {
     m.family = Family::CookTorrance;
     const std::string fresnel = d.get_string("fresnel", "schlick");
     if (fresnel != "schlick")
-      throw std::invalid_argument("model: cook-torrance: fresnel = '" + fresnel +
+      throw OptionError("model", "model: cook-torrance: fresnel = '" + fresnel +
                                   "' cannot be fitted; only fresnel=schlick (f0 is fitted)");
     choice("form", {"foley", "cook-torrance", "ngan"});
     m.inv_k = m.option == 0 ? 1.0 / (4.0 * M_PI) : m.option == 1 ? 1.0 / M_PI : 1.0 / (M_PI * M_PI);
@@ -161,14 +164,14 @@ ModelSpec parse_model(const ModelFitOptions& opt) {
       }
     }
   } else {
-    throw std::invalid_argument("model: expected blinn-phong, cook-torrance, ward, "
+    throw OptionError("model", "model: expected blinn-phong, cook-torrance, ward, "
                                 "ashikhmin-shirley or lafortune, found '" + m.name + "'");
   }
   if (opt.anisotropic && m.family != Family::Ward && m.family != Family::AshikhminShirley)
-    throw std::invalid_argument("anisotropic: only ward (ax, ay) and ashikhmin-shirley (nu, nv) have "
+    throw OptionError("anisotropic", "anisotropic: only ward (ax, ay) and ashikhmin-shirley (nu, nv) have "
                                 "anisotropic fits; " + m.name + " needs anisotropic = false");
   if (m.family != Family::Lafortune && opt.lobes != 1)
-    throw std::invalid_argument("lobes: only lafortune has lobes; " + m.name +
+    throw OptionError("lobes", "lobes: only lafortune has lobes; " + m.name +
                                 " needs lobes = 1, found " + std::to_string(opt.lobes));
   d.check_unused("model-fit " + m.name + " (fixed options only)", accepted);
   return m;
@@ -547,23 +550,22 @@ std::string fitted_assignments(const ModelSpec& m, const std::vector<double>& p)
 }  // namespace
 
 void ModelFitOptions::validate() const {
-  if (model.empty()) throw std::invalid_argument("model: expected a model name, found ''");
+  if (model.empty()) throw OptionError("model", "model: expected a model name, found ''");
   if (lobes < 1 || lobes > 3)
-    throw std::invalid_argument("lobes: expected 1..3, found " + std::to_string(lobes));
+    throw OptionError("lobes", "lobes: expected 1..3, found " + std::to_string(lobes));
   if (metric != "cosine" && metric != "log")
-    throw std::invalid_argument("metric: expected cosine or log, found '" + metric + "'");
+    throw OptionError("metric", "metric: expected cosine or log, found '" + metric + "'");
   if (cube_root && metric != "cosine")
-    throw std::invalid_argument("cube_root: applies only to metric = cosine; found metric = " +
-                                metric);
+    throw OptionError("cube_root", "cube_root: applies only to metric = \"cosine\"; found metric = " + metric);
   if (!(eps > 0.0 && eps <= 1.0))
-    throw std::invalid_argument("eps: expected 0 < eps <= 1, found " + std::to_string(eps));
+    throw OptionError("eps", "eps: expected 0 < eps <= 1, found " + std::to_string(eps));
   if (starts < 1 || starts > 1000)
-    throw std::invalid_argument("starts: expected 1..1000, found " + std::to_string(starts));
+    throw OptionError("starts", "starts: expected 1..1000, found " + std::to_string(starts));
   if (max_iterations < 1)
-    throw std::invalid_argument("max_iterations: expected >= 1, found " +
+    throw OptionError("max_iterations", "max_iterations: expected >= 1, found " +
                                 std::to_string(max_iterations));
   if (threads < 0)
-    throw std::invalid_argument("threads: expected >= 0 (0 = all hardware threads), found " +
+    throw OptionError("threads", "threads: expected >= 0 (0 = all hardware threads), found " +
                                 std::to_string(threads));
 }
 
@@ -675,9 +677,7 @@ ModelFitResult fit_model(const SampleSet& s, const ModelFitOptions& opt) {
   so.max_num_iterations = opt.max_iterations;
   so.function_tolerance = 1e-10;
   so.parameter_tolerance = 1e-10;
-  so.num_threads = opt.threads > 0
-                       ? opt.threads
-                       : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+  so.num_threads = hardware_threads(opt.threads);
   so.logging_type = ceres::SILENT;
 
   ModelFitResult res;

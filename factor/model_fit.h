@@ -80,8 +80,8 @@ struct ModelFitOptions {
   uint64_t seed = 1;              // random starts 1.. are deterministic for a seed
   int max_iterations = 100;       // Levenberg-Marquardt iterations per start, >= 1
   int threads = 0;                // Ceres threads; 0 = all hardware threads
-  // Throws std::invalid_argument naming the field, its value and the rule;
-  // unknown models and fixed options are reported when fitting.
+  // Throws OptionError (solvers/option_error.h) naming the field, its value
+  // and the rule; unknown models and fixed options are reported when fitting.
   void validate() const;
 };
 

@@ -1,5 +1,7 @@
 // Nonlinear refinement of homomorphic factorizations with Ceres (see refine.h).
 #include "factor/refine.h"
+#include "solvers/option_error.h"
+#include "solvers/parallel.h"
 
 #include <ceres/ceres.h>
 
@@ -127,19 +129,19 @@ void choose_linear_solver(RefineOptions::LinearSolver which, ceres::Solver::Opti
 void RefineOptions::validate() const {
   parse_objective(objective);
   if (!(blend_weight >= 0.0) || !std::isfinite(blend_weight))
-    throw std::invalid_argument("blend_weight: expected a finite value >= 0, found " +
+    throw OptionError("blend_weight", "blend_weight: expected a finite value >= 0, found " +
                                 std::to_string(blend_weight));
   if (max_iterations < 1)
-    throw std::invalid_argument("max_iterations: expected >= 1, found " +
+    throw OptionError("max_iterations", "max_iterations: expected >= 1, found " +
                                 std::to_string(max_iterations));
   if (!(smoothing >= 0.0) || !std::isfinite(smoothing))
-    throw std::invalid_argument("smoothing: expected a finite value >= 0, found " +
+    throw OptionError("smoothing", "smoothing: expected a finite value >= 0, found " +
                                 std::to_string(smoothing));
   if (threads < 0)
-    throw std::invalid_argument("threads: expected >= 0 (0 = all hardware threads), found " +
+    throw OptionError("threads", "threads: expected >= 0 (0 = all hardware threads), found " +
                                 std::to_string(threads));
   if (!(function_tolerance > 0.0) || !std::isfinite(function_tolerance))
-    throw std::invalid_argument("function_tolerance: expected a finite value > 0, found " +
+    throw OptionError("function_tolerance", "function_tolerance: expected a finite value > 0, found " +
                                 std::to_string(function_tolerance));
 }
 
@@ -302,8 +304,7 @@ std::shared_ptr<HomomorphicFactorization> refine(const HomomorphicFactorization&
   choose_linear_solver(opt.linear_solver, so, solver_name);
   so.max_num_iterations = opt.max_iterations;
   so.function_tolerance = opt.function_tolerance;
-  so.num_threads = opt.threads > 0 ? opt.threads
-                                   : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+  so.num_threads = hardware_threads(opt.threads);
   so.logging_type = ceres::SILENT;
   so.minimizer_progress_to_stdout = false;
   ceres::Solver::Summary summary;

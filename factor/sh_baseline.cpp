@@ -17,6 +17,7 @@
 #include "solvers/quadrature.h"
 #include "solvers/sh.h"
 #include "solvers/sh_rotation.h"
+#include "solvers/option_error.h"
 
 namespace bf {
 
@@ -42,22 +43,23 @@ int ShkOptions::auto_phi_nodes() const {
 }
 
 void ShkOptions::validate() const {
-  if (order < 0 || order > 100)
-    throw std::invalid_argument("sh-k: order: expected 0..100, found " + std::to_string(order));
-  if (view_res < 2 || view_res > 512)
-    throw std::invalid_argument("sh-k: texture_size: expected 2..512, found " +
-                                std::to_string(view_res));
-  if (theta_nodes < 0 || theta_nodes > 4096)
-    throw std::invalid_argument("sh-k: theta_nodes: expected 0 (auto) or 1..4096, found " +
-                                std::to_string(theta_nodes));
-  if (phi_nodes < 0 || phi_nodes > 8192)
-    throw std::invalid_argument("sh-k: phi_nodes: expected 0 (auto) or 1..8192, found " +
-                                std::to_string(phi_nodes));
+  if (order < 0 || order > kMaxOrder)
+    throw OptionError("order", "sh-k: order: expected 0.." + std::to_string(kMaxOrder) + ", found " +
+                                std::to_string(order));
+  if (view_res < 2 || view_res > kMaxTextureSize)
+    throw OptionError("texture_size", "sh-k: texture_size: expected 2.." + std::to_string(kMaxTextureSize) +
+                                ", found " + std::to_string(view_res));
+  if (theta_nodes < 0 || theta_nodes > kMaxThetaNodes)
+    throw OptionError("theta_nodes", "sh-k: theta_nodes: expected 0 (auto) or 1.." + std::to_string(kMaxThetaNodes) +
+                                ", found " + std::to_string(theta_nodes));
+  if (phi_nodes < 0 || phi_nodes > kMaxPhiNodes)
+    throw OptionError("phi_nodes", "sh-k: phi_nodes: expected 0 (auto) or 1.." + std::to_string(kMaxPhiNodes) +
+                                ", found " + std::to_string(phi_nodes));
   if (!(rim_inset > 0.0 && rim_inset <= 0.1))
-    throw std::invalid_argument("sh-k: rim_inset: expected 0 < rim_inset <= 0.1, found " +
+    throw OptionError("rim_inset", "sh-k: rim_inset: expected 0 < rim_inset <= 0.1, found " +
                                 std::to_string(rim_inset));
   if (!(min_cos > 0.0 && min_cos <= 1.0))
-    throw std::invalid_argument("sh-k: min_cos: expected 0 < min_cos <= 1, found " +
+    throw OptionError("min_cos", "sh-k: min_cos: expected 0 < min_cos <= 1, found " +
                                 std::to_string(min_cos));
 }
 
@@ -339,33 +341,33 @@ int ShrOptions::auto_phi_nodes() const {
 }
 
 void ShrOptions::validate() const {
-  if (max_order < 0 || max_order > 200)
-    throw std::invalid_argument("sh-r: max_order: expected 0..200, found " + std::to_string(max_order));
-  if (max_view_order < 0 || max_view_order > 32)
-    throw std::invalid_argument("sh-r: max_view_order: expected 0..32, found " +
-                                std::to_string(max_view_order));
+  if (max_order < 0 || max_order > kMaxOrder)
+    throw OptionError("max_order", "sh-r: max_order: expected 0.." + std::to_string(kMaxOrder) + ", found " +
+                                std::to_string(max_order));
+  if (max_view_order < 0 || max_view_order > kMaxViewOrder)
+    throw OptionError("max_view_order", "sh-r: max_view_order: expected 0.." + std::to_string(kMaxViewOrder) +
+                                ", found " + std::to_string(max_view_order));
   if ((order >= 0) != (view_order >= 0))
     throw std::invalid_argument("sh-r: order and view_order are set together (fixed orders) or "
                                 "both left at -1 (orders from energy_eps); found order=" +
                                 std::to_string(order) + ", view_order=" + std::to_string(view_order));
   if (order > max_order)
-    throw std::invalid_argument("sh-r: order: expected <= max_order (" + std::to_string(max_order) +
+    throw OptionError("order", "sh-r: order: expected <= max_order (" + std::to_string(max_order) +
                                 "), found " + std::to_string(order));
   if (view_order > max_view_order)
-    throw std::invalid_argument("sh-r: view_order: expected <= max_view_order (" +
+    throw OptionError("view_order", "sh-r: view_order: expected <= max_view_order (" +
                                 std::to_string(max_view_order) + "), found " +
                                 std::to_string(view_order));
   if (!(energy_eps > 0.0 && energy_eps < 1.0))
-    throw std::invalid_argument("sh-r: energy_eps: expected 0 < eps < 1, found " +
+    throw OptionError("energy_eps", "sh-r: energy_eps: expected 0 < eps < 1, found " +
                                 std::to_string(energy_eps));
-  for (auto [name, v, cap] : {std::tuple{"theta_i_nodes", theta_i_nodes, 100000},
-                              std::tuple{"theta_o_nodes", theta_o_nodes, 100000},
-                              std::tuple{"phi_nodes", phi_nodes, 100000}})
-    if (v < 0 || v > cap)
-      throw std::invalid_argument(std::string("sh-r: ") + name +
-                                  ": expected 0 (auto) or 1..100000, found " + std::to_string(v));
+  for (auto [name, v] : {std::pair{"theta_i_nodes", theta_i_nodes}, std::pair{"theta_o_nodes", theta_o_nodes},
+                         std::pair{"phi_nodes", phi_nodes}})
+    if (v < 0 || v > kMaxNodes)
+      throw std::invalid_argument(std::string("sh-r: ") + name + ": expected 0 (auto) or 1.." +
+                                  std::to_string(kMaxNodes) + ", found " + std::to_string(v));
   if (!(min_cos > 0.0 && min_cos <= 1.0))
-    throw std::invalid_argument("sh-r: min_cos: expected 0 < min_cos <= 1, found " +
+    throw OptionError("min_cos", "sh-r: min_cos: expected 0 < min_cos <= 1, found " +
                                 std::to_string(min_cos));
 }
 

@@ -29,6 +29,8 @@ namespace bf {
 // ================================================================ SH-K
 
 struct ShkOptions {
+  // Ranges checked by validate() (and shown by the config reader and docs).
+  static constexpr int kMaxOrder = 100, kMaxTextureSize = 512, kMaxThetaNodes = 4096, kMaxPhiNodes = 8192;
   int order = 4;            // band limit F >= 0: (F+1)^2 coefficients per view texel
   int view_res = 32;        // texture_size: view_res x view_res parabolic view grid (DiskGrid), 2..512
   // Quadrature over the upper hemisphere of s: theta_nodes Gauss-Legendre nodes
@@ -128,6 +130,8 @@ SizeChoice select_shk_order(const Brdf& brdf, const SampleSet& samples, const Sh
 // product function is rho_hat(ti, to, phi) = f(L, V) max(0, N.L), L and V
 // expressed in a tangent frame of N. to = 2 theta_v lies in [0, pi).
 struct ShrOptions {
+  // Ranges checked by validate() (and shown by the config reader and docs).
+  static constexpr int kMaxOrder = 200, kMaxViewOrder = 32, kMaxNodes = 100000;
   int max_order = 60;       // F cap: l = 0..F over theta_i' (about R)
   int max_view_order = 8;   // P cap: p = 0..P over theta_o'
   // Orders: the smallest (F, P) capturing 1 - energy_eps of the energy in

@@ -271,90 +271,9 @@ std::vector<StressCase> stress_cases() {
 
 double normal_matrix_condition(const FitData& d, const std::vector<TermSpec>& joint,
                                const FitOptions& opt, size_t max_unknowns, size_t* unknowns) {
-  // Unknown layout as in solve_joint: mask = projection mask + corners of
-  // every cell a sample (or its conjugate) falls in.
-  struct Layout {
-    Projection p, conj;
-    bool reciprocal;
-    std::vector<int> unk;
-    int first = 0, count = 0;
-  };
-  std::vector<Layout> L;
-  int M = 0;
-  auto cell_of = [](const Projection& p, const Vec4& x, double& a, double& b) {
-    const Eigen::Vector2d s = p.texel_coords(x);
-    const int R = p.res;
-    const double u = std::clamp(s[0], 0.0, double(R - 1)), v = std::clamp(s[1], 0.0, double(R - 1));
-    const int i = std::min(static_cast<int>(u), R - 2), j = std::min(static_cast<int>(v), R - 2);
-    a = u - i;
-    b = v - j;
-    return j * R + i;
-  };
-  for (const TermSpec& t : joint) {
-    Layout l{t.proj, t.proj.conjugate(), t.reciprocal, {}, M, 0};
-    std::vector<uint8_t> mask = projection_mask(t.proj);
-    const int R = t.proj.res;
-    for (const Vec4& x : d.points(t.proj.param))
-      for (int h = 0; h < (t.reciprocal ? 2 : 1); ++h) {
-        double a, b;
-        const int c = cell_of(h ? l.conj : l.p, x, a, b);
-        mask[c] = mask[c + 1] = mask[c + R] = mask[c + R + 1] = 1;
-      }
-    l.unk.assign(mask.size(), -1);
-    for (size_t i = 0; i < mask.size(); ++i)
-      if (mask[i]) l.unk[i] = M++;
-    l.count = M - l.first;
-    L.push_back(std::move(l));
-  }
-  if (unknowns) *unknowns = static_cast<size_t>(M);
-  if (static_cast<size_t>(M) > max_unknowns) return kNaN;
-  Eigen::MatrixXd A = Eigen::MatrixXd::Zero(M, M);
-  std::vector<int> idx;
-  std::vector<double> val;
-  for (size_t k = 0; k < d.size(); ++k) {
-    idx.clear();
-    val.clear();
-    for (const Layout& l : L) {
-      const Vec4& x = d.points(l.p.param)[k];
-      const int R = l.p.res;
-      for (int h = 0; h < (l.reciprocal ? 2 : 1); ++h) {
-        double a, b;
-        const int c = cell_of(h ? l.conj : l.p, x, a, b);
-        const int id[4] = {l.unk[c], l.unk[c + 1], l.unk[c + R], l.unk[c + R + 1]};
-        const double w[4] = {(1 - a) * (1 - b), a * (1 - b), (1 - a) * b, a * b};
-        for (int e = 0; e < 4; ++e) {
-          idx.push_back(id[e]);
-          val.push_back(w[e]);
-        }
-      }
-    }
-    for (size_t i = 0; i < idx.size(); ++i)
-      for (size_t j = 0; j < idx.size(); ++j) A(idx[i], idx[j]) += d.w[k] * val[i] * val[j];
-  }
-  const double mu = opt.smoothing * d.W / std::max(M, 1);
-  for (const Layout& l : L) {
-    const int R = l.p.res;
-    for (int j = 0; j < R; ++j)
-      for (int i = 0; i < R; ++i) {
-        const int c = l.unk[j * R + i];
-        if (c < 0) continue;
-        std::vector<std::pair<int, double>> row{{c, 0.0}};
-        const int nb[4][2] = {{i - 1, j}, {i + 1, j}, {i, j - 1}, {i, j + 1}};
-        for (const auto& q : nb) {
-          if (q[0] < 0 || q[0] >= R || q[1] < 0 || q[1] >= R) continue;
-          const int u = l.unk[q[1] * R + q[0]];
-          if (u < 0) continue;
-          row.push_back({u, -1.0});
-          row[0].second += 1.0;
-        }
-        if (row.size() < 2) continue;
-        for (const auto& [ia, va] : row)
-          for (const auto& [ib, vb] : row) A(ia, ib) += mu * va * vb;
-      }
-  }
-  const double mean_diag = A.diagonal().sum() / std::max(M, 1);
-  for (size_t t = 1; t < L.size(); ++t)
-    A.block(L[t].first, L[t].first, L[t].count, L[t].count).array() += mean_diag / L[t].count;
+  // The fit's own normal matrix (factor/homomorphic_fit.h), without its ridge.
+  const Eigen::MatrixXd A = joint_normal_matrix(d, joint, opt, max_unknowns, unknowns);
+  if (A.size() == 0) return kNaN;
   Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(A, Eigen::EigenvaluesOnly);
   if (es.info() != Eigen::Success) return kNaN;
   const double lo = es.eigenvalues().minCoeff(), hi = es.eigenvalues().maxCoeff();

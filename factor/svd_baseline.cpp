@@ -12,6 +12,7 @@
 #include "factor/metrics.h"
 #include "factor/projection.h"
 #include "solvers/parallel.h"
+#include "solvers/option_error.h"
 
 namespace bf {
 
@@ -77,15 +78,15 @@ Eigen::Vector2d DiskGrid::coords(const Vec2& p) const {
 
 void SvdOptions::validate() const {
   if (res < 2 || res > 256)
-    throw std::invalid_argument("svd: texture_size: expected 2..256, found " + std::to_string(res));
-  if (rank < 1) throw std::invalid_argument("svd: terms: expected >= 1, found " + std::to_string(rank));
+    throw OptionError("texture_size", "svd: texture_size: expected 2..256, found " + std::to_string(res));
+  if (rank < 1) throw OptionError("terms", "svd: terms: expected >= 1, found " + std::to_string(rank));
   if (!(eps > 0.0 && eps <= 1.0))
-    throw std::invalid_argument("svd: eps: expected 0 < eps <= 1, found " + std::to_string(eps));
+    throw OptionError("eps", "svd: eps: expected 0 < eps <= 1, found " + std::to_string(eps));
   if (!(rim_inset >= 0.0 && rim_inset <= 0.5))
-    throw std::invalid_argument("svd: rim_inset: expected 0 (half a texel) or 0 < rim_inset <= 0.5, found " +
+    throw OptionError("rim_inset", "svd: rim_inset: expected 0 (half a texel) or 0 < rim_inset <= 0.5, found " +
                                 std::to_string(rim_inset));
   if (subtract_eps && !log)
-    throw std::invalid_argument("svd: subtract_eps applies only to the log-space SVD (log = true)");
+    throw OptionError("svd", "svd: subtract_eps applies only to the log-space SVD (log = true)");
 }
 
 double SvdOptions::effective_rim_inset() const {
@@ -337,7 +338,7 @@ void Tolerance::validate() const {
   Metrics probe;
   metric_value(probe, metric);  // throws naming the accepted metrics
   if (!(value > 0.0) || !std::isfinite(value))
-    throw std::invalid_argument("tolerance: value: expected a finite number > 0, found " +
+    throw OptionError("tolerance", "tolerance: value: expected a finite number > 0, found " +
                                 std::to_string(value));
 }
 

@@ -1,5 +1,6 @@
 // Powell direction-set search over quaternion pairs (see powell.h).
 #include "search/powell.h"
+#include "solvers/option_error.h"
 
 #include <cmath>
 #include <stdexcept>
@@ -9,16 +10,16 @@
 namespace bf {
 
 void PowellOptions::validate() const {
-  if (!(ftol > 0)) throw std::invalid_argument("ftol: expected > 0, found " + std::to_string(ftol));
+  if (!(ftol > 0)) throw OptionError("ftol", "ftol: expected > 0, found " + std::to_string(ftol));
   if (!(line_tol > 0))
-    throw std::invalid_argument("line_tol: expected > 0, found " + std::to_string(line_tol));
+    throw OptionError("line_tol", "line_tol: expected > 0, found " + std::to_string(line_tol));
   if (!(initial_step > 0 && initial_step < 2 * M_PI))
-    throw std::invalid_argument("initial_step: expected in (0, 2 pi), found " +
+    throw OptionError("initial_step", "initial_step: expected in (0, 2 pi), found " +
                                 std::to_string(initial_step));
   if (max_sweeps < 1)
-    throw std::invalid_argument("max_sweeps: expected >= 1, found " + std::to_string(max_sweeps));
+    throw OptionError("max_sweeps", "max_sweeps: expected >= 1, found " + std::to_string(max_sweeps));
   if (max_evaluations < 10)
-    throw std::invalid_argument("max_evaluations: expected >= 10, found " +
+    throw OptionError("max_evaluations", "max_evaluations: expected >= 10, found " +
                                 std::to_string(max_evaluations));
 }
 

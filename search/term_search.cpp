@@ -1,5 +1,7 @@
 // Greedy projection search (see term_search.h).
 #include "search/term_search.h"
+#include "solvers/option_error.h"
+#include "solvers/parallel.h"
 
 #include <nlopt.hpp>
 
@@ -24,35 +26,35 @@ double now_seconds() {
 }  // namespace
 
 void SearchOptions::validate() const {
-  if (terms < 1) throw std::invalid_argument("terms: expected >= 1, found " + std::to_string(terms));
+  if (terms < 1) throw OptionError("terms", "terms: expected >= 1, found " + std::to_string(terms));
   if (texture_size < 2 || texture_size > 1024)
-    throw std::invalid_argument("texture_size: expected 2..1024, found " +
+    throw OptionError("texture_size", "texture_size: expected 2..1024, found " +
                                 std::to_string(texture_size));
   if (search_texture_size != 0 && (search_texture_size < 2 || search_texture_size > 1024))
-    throw std::invalid_argument("search_texture_size: expected 0 (same as texture_size) or "
+    throw OptionError("search_texture_size", "search_texture_size: expected 0 (same as texture_size) or "
                                 "2..1024, found " + std::to_string(search_texture_size));
   if (restarts < 0)
-    throw std::invalid_argument("restarts: expected >= 0, found " + std::to_string(restarts));
+    throw OptionError("restarts", "restarts: expected >= 0, found " + std::to_string(restarts));
   for (const auto& g : guesses) guess_rotation(g);  // throws for unknown names
   if (restarts == 0 && guesses.empty())
-    throw std::invalid_argument("restarts: 0 restarts and no guesses leave nothing to search from");
+    throw OptionError("restarts", "restarts: 0 restarts and no guesses leave nothing to search from");
   if (std::find(std::begin(kOptimizers), std::end(kOptimizers), optimizer) == std::end(kOptimizers))
-    throw std::invalid_argument("optimizer: expected powell, praxis, bobyqa, neldermead, sbplx, "
+    throw OptionError("optimizer", "optimizer: expected powell, praxis, bobyqa, neldermead, sbplx, "
                                 "direct or crs, found \"" + optimizer + "\"");
   if (threads < 0)
-    throw std::invalid_argument("threads: expected >= 0, found " + std::to_string(threads));
+    throw OptionError("threads", "threads: expected >= 0, found " + std::to_string(threads));
   const int starts = restarts + static_cast<int>(guesses.size());
   if (beam < 1 || beam > starts)
-    throw std::invalid_argument("beam: expected 1..(restarts + guesses) = 1.." +
+    throw OptionError("beam", "beam: expected 1..(restarts + guesses) = 1.." +
                                 std::to_string(starts) + ", found " + std::to_string(beam));
   if (backfit_sweeps < 0)
-    throw std::invalid_argument("backfit_sweeps: expected >= 0, found " +
+    throw OptionError("backfit_sweeps", "backfit_sweeps: expected >= 0, found " +
                                 std::to_string(backfit_sweeps));
   if (backfit_restarts < 0)
-    throw std::invalid_argument("backfit_restarts: expected >= 0, found " +
+    throw OptionError("backfit_restarts", "backfit_restarts: expected >= 0, found " +
                                 std::to_string(backfit_restarts));
   if (stop_after_term && beam != 1)
-    throw std::invalid_argument("beam: a stopping rule (tolerance) ends the greedy search after a term, "
+    throw OptionError("beam", "beam: a stopping rule (tolerance) ends the greedy search after a term, "
                                 "which needs beam = 1; found beam = " + std::to_string(beam));
   fit.validate();
   powell.validate();
@@ -162,8 +164,7 @@ namespace {
 // Minimizes f from every start, in parallel (results independent of scheduling).
 std::vector<StartResult> run_starts(const RotationObjective& f, const std::vector<Rotation4>& starts,
                                     const SearchOptions& opt) {
-  const unsigned hw = std::max(1u, std::thread::hardware_concurrency());
-  const unsigned nthreads = opt.threads > 0 ? opt.threads : hw;
+  const unsigned nthreads = static_cast<unsigned>(hardware_threads(opt.threads));
   std::vector<StartResult> results(starts.size());
   std::atomic<size_t> next{0};
   auto worker = [&] {

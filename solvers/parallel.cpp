@@ -9,9 +9,13 @@
 
 namespace bf {
 
+int hardware_threads(int requested) {
+  return requested > 0 ? requested : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+}
+
 void parallel_for(int64_t n, const std::function<void(int64_t, int64_t)>& body, int threads) {
   if (n <= 0) return;
-  int64_t t = threads > 0 ? threads : int64_t(std::max(1u, std::thread::hardware_concurrency()));
+  int64_t t = hardware_threads(threads);
   t = std::min<int64_t>(t, n);
   if (t == 1) {
     body(0, n);

@@ -8,6 +8,10 @@
 
 namespace bf {
 
+// The thread count a `threads` option asks for: `requested` when > 0, else
+// the hardware threads (at least 1). The one definition of "0 = all cores".
+int hardware_threads(int requested = 0);
+
 // Calls body(begin, end) on disjoint chunks covering [0, n), from up to
 // `threads` threads (0 = std::thread::hardware_concurrency()); the calling
 // thread takes part. Chunks are contiguous and in order per thread, so a body

@@ -2,6 +2,7 @@
 #include <algorithm>
 
 #include "experiments/config.h"
+#include "experiments/methods/method_kind.h"
 #include "experiments_helpers.h"
 
 using namespace bf;
@@ -331,9 +332,9 @@ restarts = 1
 TEST_CASE("config: every key is documented in docs/experiments.md") {
   const std::string doc = read_text(source_path("docs/experiments.md"));
   REQUIRE(!doc.empty());
-  for (const char* section : {"top", "experiment", "sampling", "scene", "brdf", "projection", "tolerance",
-                              "method:mccool", "method:fit", "method:search", "method:svd", "method:sh-k",
-                              "method:sh-r"})
+  std::vector<std::string> sections = {"top", "experiment", "sampling", "scene", "brdf", "projection", "tolerance"};
+  for (const auto& kind : method_kind_names()) sections.push_back("method:" + kind);  // every registered kind
+  for (const auto& section : sections)
     for (const auto& key : config_keys(section)) {
       INFO(section << "." << key);
       CHECK(doc.find("`" + key + "`") != std::string::npos);

@@ -1,8 +1,10 @@
 // Tests of the homomorphic fit: planted solutions, bilinear convergence,
 // reciprocity, McCool's form, fast path vs reference path, degenerate input.
+#include <Eigen/Dense>
 #include <cmath>
 #include <random>
 
+#include "brdfs/catalogue.h"
 #include "brdfs/models.h"
 #include "brdfs/sampleset.h"
 #include "factor/homomorphic_fit.h"
@@ -386,4 +388,26 @@ TEST_CASE("fit: Laplacian smoothing keeps constants exactly and flattens the tex
   CHECK(rough[2] < 0.1 * rough[1]);
   CHECK(mse[0] < mse[1]);
   CHECK(mse[1] < mse[2]);
+
+TEST_CASE("fit: the exposed normal matrix is symmetric and sums to the sample weights for one term") {
+  const BrdfPtr b = Catalogue::builtin().make("cook-torrance:m=0.3");
+  const SampleSet s = sample_stratified(*b, 3000, 3);
+  const FitData d(s, 1e-5);
+  FitOptions opt;
+  // One non-reciprocal term: every sample's 4 bilinear weights sum to 1 and the
+  // Laplacian annihilates constants, so 1^T A 1 = sum of the sample weights.
+  const std::vector<TermSpec> one = {{projection_first_pair(Parameterization::WiWo, 8), false, std::nullopt}};
+  size_t m = 0;
+  const Eigen::MatrixXd A = joint_normal_matrix(d, one, opt, 100000, &m);
+  REQUIRE(A.rows() == static_cast<Eigen::Index>(m));
+  CHECK((A - A.transpose()).norm() == 0.0);
+  CHECK(A.sum() == Approx(d.W).epsilon(1e-10));
+  // Positive definite once the fit's ridge is added (the fit factors it).
+  const double ridge = 1e-12 * A.diagonal().mean();
+  CHECK(Eigen::LLT<Eigen::MatrixXd>(A + ridge * Eigen::MatrixXd::Identity(A.rows(), A.cols())).info() ==
+        Eigen::Success);
+  // Above the cap: nothing assembled, the unknowns still counted.
+  size_t m2 = 0;
+  CHECK(joint_normal_matrix(d, one, opt, 10, &m2).size() == 0);
+  CHECK(m2 == m);
 }

@@ -1,0 +1,190 @@
+// The homomorphic kinds' shared keys, refinement stage, columns and export (see homomorphic.h).
+#include "experiments/methods/homomorphic.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "experiments/cli_util.h"
+#include "factor/export.h"
+#include "factor/refine.h"
+
+namespace bf {
+
+using nlohmann::json;
+
+std::vector<KeySpec> fit_keys(const KeySpec& texture_size) {
+  return {texture_size,
+          num_key("smoothing", 0.0, kInf, false, "1e-3", "Laplacian weight relative to the mean sample weight per texel"),
+          num_key("eps", 0.0, 1.0, true, "1e-5", "log-transform eps of the fit (DESIGN.md §2)"),
+          bool_key("subtract_eps", "true",
+                   "reconstruct A·exp(s) − eps·A (clamped at 0) instead of A·exp(s); run.json says which"),
+          int_key("solve_last", 1, 64, "2", "n: the last n terms are solved jointly (thesis 3.2.2)"),
+          choice_key("solver", {"auto", "dense", "sparse", "qr"}, "auto",
+                     "linear solver of the fit; qr is the slow reference path")};
+}
+
+KeySpec homomorphic_texture_key() {
+  return other_key("texture_size", "integer 2..1024 or `\"auto\"`", "16",
+                   "textures are texture_size² texels; `\"auto\"`: chosen by the tolerance from `texture_ladder`");
+}
+
+std::vector<KeySpec> refine_keys() {
+  return {num_key("refine_blend", 0.0, kInf, false, "0.03",
+                  "`blend` only: weight of the linear-space residuals against the log-space ones (0 = rel_mse alone)"),
+          int_key("refine_iterations", 1, 100000, "50", "Levenberg–Marquardt iterations at most"),
+          num_key("refine_smoothing", 0.0, kInf, false, "the method's `smoothing`",
+                  "Laplacian weight of the refinement, in the fit's units")};
+}
+
+namespace {
+
+FitOptions::Solver parse_solver(const std::string& s) {
+  if (s == "dense") return FitOptions::Solver::Dense;
+  if (s == "sparse") return FitOptions::Solver::Sparse;
+  if (s == "qr") return FitOptions::Solver::ReferenceQR;
+  return FitOptions::Solver::Auto;
+}
+
+const KeySpec& fit_key(const std::string& name) {
+  static const std::vector<KeySpec> keys = fit_keys(homomorphic_texture_key());
+  return find_key(keys, name);
+}
+
+const KeySpec& refine_key(const std::string& name) {
+  static const std::vector<KeySpec> keys = refine_keys();
+  return find_key(keys, name);
+}
+
+}  // namespace
+
+void read_fit_options(Reader& r, FitOptions& f, json& o) {
+  f.eps = r.number(fit_key("eps"), f.eps);
+  f.smoothing = r.number(fit_key("smoothing"), f.smoothing);
+  f.subtract_eps = r.boolean(fit_key("subtract_eps"), f.subtract_eps);
+  f.solve_last = static_cast<int>(r.integer(fit_key("solve_last"), f.solve_last));
+  const std::string solver = r.choice(fit_key("solver"), "auto");
+  f.solver = parse_solver(solver);
+  o["eps"] = f.eps;
+  o["smoothing"] = f.smoothing;
+  o["subtract_eps"] = f.subtract_eps;
+  o["solve_last"] = f.solve_last;
+  o["solver"] = solver;
+}
+
+void read_refine_options(Reader& r, MethodVariant& m, json& o) {
+  RefineOptions& ro = m.refine_options;
+  ro.objective = m.refine == "none" ? ro.objective : m.refine;
+  ro.blend_weight = r.number(refine_key("refine_blend"), ro.blend_weight);
+  ro.max_iterations = static_cast<int>(r.integer(refine_key("refine_iterations"), ro.max_iterations));
+  const bool own_smoothing = r.has("refine_smoothing");
+  ro.smoothing = r.number(refine_key("refine_smoothing"), ro.smoothing);
+  if (m.refine != "none") {
+    if (m.refine == "blend") o["refine_blend"] = ro.blend_weight;
+    o["refine_iterations"] = ro.max_iterations;
+    // Default: the fit's own smoothing (filled in by finish_refine_options).
+    o["refine_smoothing"] = own_smoothing ? json(ro.smoothing) : json();
+  }
+  if (!own_smoothing) ro.smoothing = -1;  // = the fit's smoothing
+}
+
+void validate_fit_options(Reader& r, const MethodVariant& m) {
+  if (r.failed()) return;
+  try {
+    m.fit.validate();
+  } catch (const std::exception& e) {
+    report_invalid(r, e, method_keys(*m.impl));
+  }
+}
+
+void finish_refine_options(Reader& r, MethodVariant& m, json& o) {
+  RefineOptions& ro = m.refine_options;
+  if (ro.smoothing < 0) ro.smoothing = m.fit.smoothing;
+  if (m.refine != "none") o["refine_smoothing"] = ro.smoothing;
+  ro.threads = 1;
+  if (r.failed()) return;
+  try {
+    ro.validate();
+  } catch (const std::exception& e) {
+    report_invalid(r, e, method_keys(*m.impl), "refinement: ",
+                   {{"blend_weight", "refine_blend"}, {"max_iterations", "refine_iterations"},
+                    {"smoothing", "refine_smoothing"}});
+  }
+}
+
+MethodOutcome finish_homomorphic(const RunContext& c, HomomorphicRun run, std::optional<SizeChoice> choice,
+                                 int evaluations) {
+  const MethodVariant& m = c.method;
+  MethodOutcome out;
+  out.choice = std::move(choice);
+  out.evaluations = evaluations;
+  // Refinement (factor/refine.h): the row reports the refined factorization,
+  // the *_before columns the fit it started from.
+  if (m.refine != "none") {
+    run.before = evaluate_metrics(*run.h, c.samples, c.lt);
+    const auto t0 = std::chrono::steady_clock::now();
+    RefineReport rep;
+    try {
+      run.h = refine(*run.h, c.samples, m.refine_options, &rep);
+      out.record["refinement"] = {{"objective", rep.objective},        {"linear_solver", rep.linear_solver},
+                                  {"iterations", rep.iterations},      {"seconds", rep.seconds},
+                                  {"initial_cost", rep.initial_cost},  {"final_cost", rep.final_cost},
+                                  {"termination", rep.termination},    {"parameters", rep.parameters},
+                                  {"residuals", rep.residuals},        {"texels_added", rep.texels_added},
+                                  {"blend_weight", m.refine_options.blend_weight},
+                                  {"smoothing", m.refine_options.smoothing}};
+    } catch (const std::runtime_error& ex) {
+      // Ceres found no finite solution: the start is the best answer.
+      out.notes.push_back(std::string("refinement failed, unrefined fit kept: ") + ex.what());
+      out.record["refinement"] = {{"failed", ex.what()}};
+    }
+    run.refine_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  }
+  out.result = run.h;
+  out.state = std::move(run);
+  return out;
+}
+
+std::vector<std::string> homomorphic_columns() {
+  return {"parameterization", "reciprocity", "terms", "texture_size", "errors_after_term"};
+}
+
+void fill_homomorphic_row(const RunContext& c, MethodOutcome& out, Row& row) {
+  const auto& run = std::any_cast<const HomomorphicRun&>(out.state);
+  const HomomorphicFactorization& h = *run.h;
+  std::vector<std::string> params;
+  size_t recip = 0, symmetric = 0;
+  for (const auto& t : h.terms()) {
+    if (std::find(params.begin(), params.end(), to_string(t.proj.param)) == params.end())
+      params.push_back(to_string(t.proj.param));
+    recip += t.reciprocal;
+    symmetric += t.reciprocal || t.proj.self_conjugate();
+  }
+  row["parameterization"] = join(params, "+");
+  // true: every term is read through its conjugate or is its own conjugate
+  // (McCool's p(h) texture), so the approximation is reciprocal.
+  row["reciprocity"] = recip == 0 ? "false" : symmetric == h.terms().size() ? "true" : "mixed";
+  row["terms"] = std::to_string(h.terms().size());
+  row["texture_size"] = std::to_string(out.choice && out.choice->texture_size ? out.choice->texture_size
+                                                                              : c.method.texture_size);
+  std::vector<std::string> ec;
+  for (double v : run.errors_after_term) ec.push_back(format_number(v));
+  row["errors_after_term"] = join(ec, ";");
+  out.record["reconstruction"] = h.subtract_eps() ? "A exp(s) - eps A, clamped at 0" : "A exp(s)";
+  if (c.method.refine == "none") return;
+  row["refine"] = c.method.refine;
+  row["refine_seconds"] = format_number(std::round(run.refine_seconds * 1000.0) / 1000.0);
+  const Metrics& b = run.before;
+  const std::pair<const char*, double> cells[] = {
+      {"rel_mse_before", b.rel_mse},   {"rel_mae_before", b.rel_mae}, {"rel_max_before", b.rel_max},
+      {"lin_rmse_before", b.lin_rmse}, {"lin_mae_before", b.lin_mae}, {"lin_max_before", b.lin_max},
+      {"cos_rmse_before", b.cos_rmse}};
+  for (const auto& [k, v] : cells) row[k] = format_number(v);
+}
+
+void export_homomorphic(const RunContext& c, const MethodOutcome& out) {
+  const auto& run = std::any_cast<const HomomorphicRun&>(out.state);
+  write_factorization(*run.h, c.run_dir.string(), "factors");
+}
+
+}  // namespace bf

@@ -1,0 +1,62 @@
+// What the homomorphic kinds (mccool, fit, search) share: the fit keys, the
+// refinement stage (refine = "linear" | "cosine" | "blend", factor/refine.h)
+// run after their fit, their results columns and their exported factors.
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include "experiments/methods/method_kind.h"
+#include "factor/homomorphic_fit.h"
+
+namespace bf {
+
+// The fit keys (texture_size with the given default docs, smoothing, eps,
+// subtract_eps, solve_last, solver) and the refinement keys.
+std::vector<KeySpec> fit_keys(const KeySpec& texture_size);
+std::vector<KeySpec> refine_keys();
+// texture_size of mccool and fit: an integer or "auto" (read_texture_size).
+KeySpec homomorphic_texture_key();
+constexpr int kFitTextureMin = 2, kFitTextureMax = 1024;
+
+// Reads smoothing, eps, subtract_eps, solve_last, solver into f and o.
+void read_fit_options(Reader& r, FitOptions& f, nlohmann::json& o);
+// The refinement keys, read first (whatever refine is, so a sweep over refine
+// can carry them) and hashed only when a refinement runs.
+void read_refine_options(Reader& r, MethodVariant& m, nlohmann::json& o);
+// After the kind's keys: the refinement's default smoothing (the fit's) and its validation.
+void finish_refine_options(Reader& r, MethodVariant& m, nlohmann::json& o);
+// FitOptions::validate, reported at the table.
+void validate_fit_options(Reader& r, const MethodVariant& m);
+
+// A homomorphic run's state (MethodOutcome::state).
+struct HomomorphicRun {
+  std::shared_ptr<const HomomorphicFactorization> h;  // after refinement, if any
+  std::vector<double> errors_after_term;              // of the fit
+  Metrics before;                                     // the fit's metrics when refined
+  double refine_seconds = 0;
+};
+
+// Runs the refinement stage when m.refine != "none" and builds the outcome
+// (result, state, record "refinement", the note of a failed refinement).
+MethodOutcome finish_homomorphic(const RunContext& c, HomomorphicRun run, std::optional<SizeChoice> choice,
+                                 int evaluations);
+// Columns parameterization, reciprocity, terms, texture_size, errors_after_term,
+// refine, refine_seconds, *_before; run.json "reconstruction".
+void fill_homomorphic_row(const RunContext& c, MethodOutcome& out, Row& row);
+std::vector<std::string> homomorphic_columns();
+// factors/: textures, sidecar, GLSL.
+void export_homomorphic(const RunContext& c, const MethodOutcome& out);
+
+// Base of the homomorphic kinds: refinable, their columns, row and export.
+class HomomorphicKind : public MethodKind {
+ public:
+  bool refinable() const override { return true; }
+  std::vector<std::string> columns() const override { return homomorphic_columns(); }
+  void fill_row(const RunContext& c, MethodOutcome& out, Row& row) const override {
+    fill_homomorphic_row(c, out, row);
+  }
+  void export_files(const RunContext& c, const MethodOutcome& out) const override { export_homomorphic(c, out); }
+};
+
+}  // namespace bf

@@ -1,0 +1,240 @@
+// kind = "search": Cole's automatic factorization (search/term_search.h):
+// greedy over terms, an optimizer over 4D rotations per term, seeded random
+// restarts in parallel; with a tolerance, the search stops at the first term
+// whose refit reaches the target. Keys the search gains go here.
+#include <algorithm>
+#include <cmath>
+
+#include "experiments/methods/homomorphic.h"
+#include "search/rotation4.h"
+#include "search/term_search.h"
+#include "solvers/parallel.h"
+
+namespace bf {
+
+using nlohmann::json;
+
+namespace {
+
+const std::vector<KeySpec>& search_keys() {
+  static const std::vector<KeySpec> keys = [] {
+    std::vector<KeySpec> k = fit_keys(int_key("texture_size", 2, 1024, "16", "final resolution"));
+    const auto r = refine_keys();
+    k.insert(k.end(), r.begin(), r.end());
+    const std::vector<KeySpec> own = {
+        choice_key("parameterization", {"wiwo", "halfdiff"}, "wiwo", ""),
+        int_key("terms", 1, 64, "2; 8 with a tolerance", "textures to build; with a tolerance, the cap"),
+        other_key("search_texture_size", "0 or 2..1024", "0", "resolution during the search; 0 = texture_size"),
+        int_key("restarts", 0, 100000, "6", "seeded random starts per term"),
+        other_key("guesses", "list of `\"wi\"`, `\"wo\"`, `\"wi+wo\"`", "[]", "extra starts"),
+        bool_key("reciprocity", "false", "every term read through its conjugate too"),
+        choice_key("optimizer", {"powell", "praxis", "bobyqa", "neldermead", "sbplx", "direct", "crs"}, "powell", ""),
+        num_key("ftol", 0.0, 1.0, true, "1e-3",
+                "relative improvement per sweep below which Powell stops (also nlopt's ftol)"),
+        num_key("line_tol", 0.0, 10.0, true, "0.02", "golden-section bracket width (radians of t)"),
+        num_key("initial_step", 0.0, 6.28, true, "0.3", "first bracketing step (below 2π)"),
+        int_key("max_sweeps", 1, 100000, "30", "Powell sweeps per minimization"),
+        int_key("max_evaluations", 10, 100000000, "5000", "objective evaluations per minimization"),
+        int_key("threads", 0, 1024, "0",
+                "restarts in parallel; 0 = hardware threads. Not part of the run id (results do not depend on it)"),
+        int_key("seed", 0, kIntMax, "`experiment.seed`", "seed of the random restarts (column `seed`)"),
+        int_key("beam", 1, 100000, "1",
+                "non-greedy: the `beam` best first-term candidates (from different starts) are each continued to "
+                "the last term; the branch with the lowest final `rel_mse` (at `texture_size`) wins. Branch 1 is "
+                "the greedy search, so never worse than greedy; costs about `beam` times the searches of terms "
+                "2..J. At most restarts + guesses. run.json holds `beam_rel_mse` per branch"),
+        int_key("backfit_sweeps", 0, 1000, "0",
+                "non-greedy: after each added term j ≥ 2, terms 1..j are re-searched in turn with the other "
+                "projections held (cyclic; stops early when a sweep moves nothing), from their current rotation; "
+                "the objective is the whole fit schedule's error with that one projection changed, so each "
+                "accepted move lowers it. Per-term `backfit_evaluations` and `backfit_moves` in run.json"),
+        int_key("backfit_restarts", 0, 100000, "0",
+                "extra seeded random starts per re-search (besides the current rotation)"),
+        other_key("tolerance", "table", "",
+                  "stop after the first term that reaches the target; `terms` is then the cap (default 8); "
+                  "needs `beam = 1`")};
+    k.insert(k.end(), own.begin(), own.end());
+    return k;
+  }();
+  return keys;
+}
+
+const KeySpec& key(const std::string& name) { return find_key(search_keys(), name); }
+
+void read_guesses(Reader& r, SearchOptions& s) {
+  const toml::node* g = r.take("guesses");
+  if (!g) return;
+  auto a = g->as_array();
+  if (!a) {
+    r.fail("guesses", "expected a list of \"wi\", \"wo\", \"wi+wo\", " + found(*g));
+    return;
+  }
+  for (const auto& e : *a) {
+    auto str = e.as_string();
+    if (!str) {
+      r.fail("guesses", "expected a list of \"wi\", \"wo\", \"wi+wo\", found an element " + show(e));
+      continue;
+    }
+    try {
+      guess_rotation(str->get());
+      s.guesses.push_back(str->get());
+    } catch (const std::exception&) {
+      r.fail("guesses", "expected \"wi\", \"wo\" or \"wi+wo\", found \"" + str->get() + "\"");
+    }
+  }
+}
+
+// The search's effective options, hashed into the run id.
+void record_options(const MethodVariant& m, json& o) {
+  const SearchOptions& s = m.search;
+  o["parameterization"] = to_string(m.param);
+  o["terms"] = m.terms;
+  o["texture_size"] = m.texture_size;
+  o["search_texture_size"] = s.search_texture_size;
+  o["restarts"] = s.restarts;
+  o["guesses"] = s.guesses;
+  o["reciprocity"] = m.reciprocity;
+  o["optimizer"] = s.optimizer;
+  o["ftol"] = s.powell.ftol;
+  o["line_tol"] = s.powell.line_tol;
+  o["initial_step"] = s.powell.initial_step;
+  o["max_sweeps"] = s.powell.max_sweeps;
+  o["max_evaluations"] = s.powell.max_evaluations;
+  o["seed"] = m.seed;
+  // Non-greedy options enter the run id only when set, so greedy runs keep their cache.
+  if (s.beam != 1) o["beam"] = s.beam;
+  if (s.backfit_sweeps != 0) o["backfit_sweeps"] = s.backfit_sweeps;
+  if (s.backfit_sweeps != 0 && s.backfit_restarts != 0) o["backfit_restarts"] = s.backfit_restarts;
+}
+
+json term_records(const SearchResult& sr) {
+  json terms = json::array();
+  for (const auto& t : sr.terms)
+    terms.push_back({{"rotation", t.rotation},
+                     {"search_rel_mse", std::isfinite(t.search_rel_mse) ? json(t.search_rel_mse) : json()},
+                     {"evaluations", t.evaluations},
+                     {"seconds", t.seconds},
+                     {"best_start", t.best_start},
+                     {"backfit_evaluations", t.backfit_evaluations},
+                     {"backfit_moves", t.backfit_moves}});
+  return terms;
+}
+
+class SearchKind final : public HomomorphicKind {
+ public:
+  std::string name() const override { return "search"; }
+  std::string summary() const override {
+    return "Cole's automatic factorization: greedy over terms, Powell (or an nlopt optimizer) over 4D rotations "
+           "per term, seeded random restarts in parallel, search at `search_texture_size` and refit at "
+           "`texture_size`. `beam` and `backfit_*` enter the run id only when not at their defaults, so greedy "
+           "runs keep their cache.";
+  }
+  std::vector<KeySpec> keys() const override { return search_keys(); }
+  bool seeded() const override { return true; }
+  std::string example() const override { return "terms = 1\ntexture_size = 6\nrestarts = 1\nthreads = 1\n"; }
+  std::vector<std::string> described() const override {
+    return {"parameterization", "terms", "texture_size", "reciprocity", "restarts", "optimizer", "beam",
+            "backfit_sweeps", "seed"};
+  }
+  bool array_is_value(const std::string& key, const toml::array& a) const override {
+    return key == "guesses" && !all_arrays(a);
+  }
+
+  void read(Reader& r, MethodVariant& m, json& o, uint64_t base_seed) const override {
+    read_refine_options(r, m, o);
+    SearchOptions& s = m.search;
+    m.param = read_param(r, "parameterization", s.param);
+    m.tolerance = read_tolerance(r, o);
+    // With a tolerance, `terms` is the cap (default 8): the greedy search stops
+    // at the first term whose refit reaches the target.
+    m.terms = static_cast<int>(r.integer(key("terms"), m.tolerance ? 8 : s.terms));
+    if (m.tolerance) m.cap = m.terms;
+    m.texture_size = static_cast<int>(r.integer(key("texture_size"), s.texture_size));
+    s.search_texture_size = static_cast<int>(r.integer("search_texture_size", 0, 0, 1024));
+    if (s.search_texture_size == 1) r.fail("search_texture_size", "expected 0 (same as texture_size) or 2..1024, found 1");
+    s.restarts = static_cast<int>(r.integer(key("restarts"), s.restarts));
+    read_guesses(r, s);
+    m.reciprocity = r.boolean(key("reciprocity"), false);
+    s.optimizer = r.choice(key("optimizer"), s.optimizer);
+    s.powell.ftol = r.number(key("ftol"), s.powell.ftol);
+    s.powell.line_tol = r.number(key("line_tol"), s.powell.line_tol);
+    s.powell.initial_step = r.number(key("initial_step"), s.powell.initial_step);
+    s.powell.max_sweeps = static_cast<int>(r.integer(key("max_sweeps"), s.powell.max_sweeps));
+    s.powell.max_evaluations = static_cast<int>(r.integer(key("max_evaluations"), s.powell.max_evaluations));
+    s.threads = static_cast<int>(r.integer(key("threads"), 0));
+    s.beam = static_cast<int>(r.integer(key("beam"), s.beam));
+    s.backfit_sweeps = static_cast<int>(r.integer(key("backfit_sweeps"), s.backfit_sweeps));
+    s.backfit_restarts = static_cast<int>(r.integer(key("backfit_restarts"), s.backfit_restarts));
+    m.seed = static_cast<uint64_t>(r.integer(key("seed"), static_cast<int64_t>(base_seed)));
+    read_fit_options(r, m.fit, o);
+    if (s.restarts == 0 && s.guesses.empty() && !r.failed())
+      r.fail("restarts", "restarts = 0 and no guesses leave nothing to search from (give restarts >= 1 or guesses)");
+    s.terms = m.terms;
+    s.param = m.param;
+    s.texture_size = m.texture_size;
+    s.reciprocity = m.reciprocity;
+    s.fit = m.fit;
+    s.seed = m.seed;
+    record_options(m, o);
+    if (m.tolerance && s.beam != 1)
+      r.fail("tolerance", "a tolerance stops the greedy search after a term, which needs beam = 1; found beam = " +
+                              std::to_string(s.beam));
+    m.execution["threads"] = s.threads;
+    const int starts = s.restarts + static_cast<int>(s.guesses.size());
+    m.cores = std::max(1, std::min(hardware_threads(s.threads), starts));
+    if (!r.failed()) {
+      try {
+        s.validate();
+      } catch (const std::exception& e) {
+        report_invalid(r, e, method_keys(*this));
+      }
+    }
+    finish_refine_options(r, m, o);
+  }
+
+  MethodOutcome run(const RunContext& c) const override {
+    const MethodVariant& m = c.method;
+    const FitData data(c.samples, m.fit.eps);
+    SearchOptions so = m.search;
+    SizeChoice choice;  // with a tolerance: the terms tried, filled as the search goes
+    if (m.tolerance) {
+      // The greedy search stops at the first term whose refit reaches the
+      // target (search/term_search.h, stop_after_term); later terms are never searched.
+      choice.method = "search";
+      choice.knob = "terms";
+      choice.metric = m.tolerance->metric;
+      so.stop_after_term = [&](const HomomorphicFactorization& hf) {
+        const double v = metric_value(evaluate_metrics(hf, c.samples, c.lt), choice.metric);
+        choice.tried.push_back({static_cast<int>(hf.terms().size()), -1, v});
+        choice.value = static_cast<int>(hf.terms().size());
+        choice.error = v;
+        choice.reached = v <= m.tolerance->value;
+        return choice.reached;
+      };
+    }
+    SearchResult sr = search_factorization(data, so);
+    std::optional<SizeChoice> chosen;
+    if (m.tolerance) {
+      choice.seconds = sr.seconds;
+      choice.result = sr.factorization;
+      choice.errors_after_term = sr.rel_mse_after_term;
+      chosen = choice;
+    }
+    HomomorphicRun run;
+    run.h = sr.factorization;
+    run.errors_after_term = sr.rel_mse_after_term;
+    MethodOutcome out = finish_homomorphic(c, std::move(run), std::move(chosen), sr.evaluations);
+    out.record["terms"] = term_records(sr);
+    if (sr.beam_rel_mse.size() > 1) {
+      out.record["beam_rel_mse"] = sr.beam_rel_mse;
+      out.record["best_branch"] = sr.best_branch;
+    }
+    return out;
+  }
+};
+
+}  // namespace
+
+std::shared_ptr<const MethodKind> make_search_kind() { return std::make_shared<SearchKind>(); }
+
+}  // namespace bf

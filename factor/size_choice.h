@@ -1,0 +1,52 @@
+// The types of tolerance-driven size selection (DESIGN.md §9 "what a scene
+// needs"), shared by the SVD and SH baselines (factor/svd_baseline.h,
+// factor/sh_baseline.h), the homomorphic fits (factor/size_select.h) and the
+// search's stopping rule: an error target, the candidates scored, the choice.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "factor/factorization.h"
+
+namespace bf {
+
+// An error target: a metric of factor/metrics.h (metric_value names) and a value.
+struct Tolerance {
+  std::string metric = "cos_rmse";
+  double value = 0.0;  // > 0
+  // Throws std::invalid_argument for an unknown metric or value <= 0 / NaN.
+  void validate() const;
+};
+
+// One scored candidate of a selection.
+struct SizeTrial {
+  int value = 0;        // rank K or order F
+  int view_order = -1;  // SH-R: view order P; -1 otherwise
+  double error = 0;     // the tolerance metric
+  int texture_size = 0; // resolution of the trial when it is chosen too (select_*_size); 0 otherwise
+};
+
+// What a selection chose, with its error and time (a row of a report).
+struct SizeChoice {
+  std::string method;   // "svd", "sh-k", "sh-r"
+  std::string knob;     // "terms" (SVD rank) or "order" (SH band limit F)
+  int value = 0;        // the chosen rank / order
+  int view_order = -1;  // SH-R: the chosen view order P; -1 otherwise
+  int texture_size = 0; // the chosen resolution (select_*_size); 0 when the resolution was fixed
+  std::string metric;   // tolerance metric
+  double error = 0;     // metric at the choice
+  bool reached = false; // error <= tolerance; false: nothing up to the cap reached it, value is the best tried
+  double seconds = 0;   // wall time: tabulation/projection + decompositions + scoring
+  std::vector<SizeTrial> tried;  // in the order scored
+  FactorizationPtr result;       // the chosen approximation
+  std::vector<double> errors_after_term;  // homomorphic: rel_mse after each term of the chosen fit
+};
+
+// The resolutions tried when texture_size = "auto": 8, 12, 16, 24, 32.
+const std::vector<int>& default_texture_ladder();
+// Throws std::invalid_argument unless ladder is non-empty, strictly
+// ascending and every entry lies in lo..hi; `what` names the field.
+void validate_texture_ladder(const std::vector<int>& ladder, int lo, int hi, const std::string& what);
+
+}  // namespace bf
