@@ -388,6 +388,7 @@ TEST_CASE("fit: Laplacian smoothing keeps constants exactly and flattens the tex
   CHECK(rough[2] < 0.1 * rough[1]);
   CHECK(mse[0] < mse[1]);
   CHECK(mse[1] < mse[2]);
+}
 
 TEST_CASE("fit: the exposed normal matrix is symmetric and sums to the sample weights for one term") {
   const BrdfPtr b = Catalogue::builtin().make("cook-torrance:m=0.3");
