@@ -5,6 +5,7 @@
 
 #include "brdfs/merl.h"
 #include "common.h"
+#include "factor/baseline_export.h"
 #include "factor/export.h"
 #include "factor/homomorphic.h"
 #include "factor/model_fit.h"
@@ -147,12 +148,14 @@ load(sidecar) reads it back (bit-identical evaluation).)doc")
   m.def(
       "load",
       [](const std::string& path) -> py::object {
-        std::string format;
+        std::string format, method;
         {
           std::ifstream in(path);
           if (!in) throw std::invalid_argument(path + ": cannot open");
           try {
-            format = nlohmann::json::parse(in).value("format", "");
+            const nlohmann::json j = nlohmann::json::parse(in);
+            format = j.is_object() ? j.value("format", "") : "";
+            method = j.is_object() && j.contains("method") && j["method"].is_string() ? j["method"].get<std::string>() : "";
           } catch (const nlohmann::json::exception& e) {
             throw std::invalid_argument(path + ": not a JSON file (" + e.what() + ")");
           }
@@ -161,6 +164,14 @@ load(sidecar) reads it back (bit-identical evaluation).)doc")
           auto b = std::make_shared<PyBrdf>();
           b->brdf = load_model_fit(path);
           return py::cast(b);
+        }
+        if (format == kFactorExportFormat && is_baseline_method(method)) {  // svd, sh-k, sh-r
+          std::shared_ptr<Factorization> b;
+          {
+            py::gil_scoped_release release;
+            b = load_baseline_export(path);
+          }
+          return py::cast(wrap(b));
         }
         std::shared_ptr<const HomomorphicFactorization> h;
         {
@@ -171,7 +182,8 @@ load(sidecar) reads it back (bit-identical evaluation).)doc")
       },
       py::arg("path"),
       R"doc(Reads an export back: a factorization sidecar (STEM.json of mccool, fit,
-search) as a Factorization (metrics None), a model-fit JSON as a Brdf.)doc");
+search, svd, sh-k, sh-r) as a Factorization (metrics None), a model-fit JSON
+as a Brdf.)doc");
 }
 
 }  // namespace bf::py_module

@@ -7,6 +7,8 @@
 #include "brdfs/catalogue.h"
 #include "common.h"
 #include "experiments/config.h"
+#include "experiments/config_reader.h"
+#include "experiments/methods/method_kind.h"
 #include "factor/export.h"
 
 namespace bf::py_module {
@@ -133,9 +135,29 @@ std::string range_num(double lo, double hi, bool lo_open) {
 
 }  // namespace
 
+namespace {
+// The range the config reader enforces for `key` of method kind `kind`, from
+// the method catalogue (experiments/methods/): a keyword argument is held to
+// the same range as the config key, stated in one place. nullptr for keys the
+// catalogue does not describe (their range is the caller's).
+const KeySpec* catalogue_spec(const std::string& kind, const std::string& key, KeySpec::Type type) {
+  const MethodKind* k = find_method_kind(kind);
+  if (!k) return nullptr;
+  static thread_local std::vector<KeySpec> keys;
+  keys = k->keys();
+  for (const KeySpec& s : keys)
+    if (s.name == key && s.type == type) return &s;
+  return nullptr;
+}
+}  // namespace
+
 int Options::integer(const std::string& key, int def, long long lo, long long hi) {
   py::object o = take(key);
   if (o.is_none()) return def;
+  if (const KeySpec* s = catalogue_spec(kind_, key, KeySpec::Type::Integer)) {
+    lo = s->int_lo;
+    hi = s->int_hi >= kIntMax ? kNoLimit : s->int_hi;
+  }
   const std::string range = range_int(lo, hi);
   // bool is an int subclass in Python; numpy integers have __index__.
   if (py::isinstance<py::bool_>(o) || !PyIndex_Check(o.ptr())) type_error(key, "an integer" + range, o);
@@ -162,6 +184,11 @@ uint64_t Options::seed(const std::string& key, uint64_t def) {
 double Options::number(const std::string& key, double def, double lo, double hi, bool lo_open) {
   py::object o = take(key);
   if (o.is_none()) return def;
+  if (const KeySpec* s = catalogue_spec(kind_, key, KeySpec::Type::Number)) {
+    lo = s->lo;
+    hi = s->hi;
+    lo_open = s->lo_open;
+  }
   const std::string range = range_num(lo, hi, lo_open);
   if (py::isinstance<py::bool_>(o) || !(PyFloat_Check(o.ptr()) || PyIndex_Check(o.ptr()) ||
                                         py::hasattr(o, "__float__")))
