@@ -116,7 +116,8 @@ const std::map<std::string, std::vector<std::string>>& key_table() {
                   {"parameterization", "terms", "search_texture_size", "restarts", "guesses",
                    "reciprocity", "optimizer", "ftol", "line_tol", "initial_step", "max_sweeps",
                    "max_evaluations", "threads", "seed", "beam", "backfit_sweeps",
-                   "backfit_restarts", "tolerance"}})},
+                   "backfit_restarts", "tolerance", "strategy", "term_param", "keep",
+                   "polish_sweeps"}})},
       {"method:svd", join_keys({kCommonMethodKeys,
                                 {"texture_size", "terms", "parameterization", "log", "eps",
                                  "subtract_eps", "rim_inset", "extend_below_horizon",
@@ -1407,6 +1408,12 @@ void read_method(Reader& r, Ctx& ctx, const std::string& kind, uint64_t base_see
     cap_terms(n);
   } else if (kind == "search") {
     SearchOptions& s = m.search;
+    // Configs default to Cole's greedy search (existing configs keep their
+    // results and run ids); strategy = "structured" selects the new search.
+    s.strategy = r.choice("strategy", "greedy", {"greedy", "structured"});
+    s.term_param = r.choice("term_param", s.term_param, {"either", "fixed"});
+    s.keep = static_cast<int>(r.integer("keep", s.keep, 1, 1000));
+    s.polish_sweeps = static_cast<int>(r.integer("polish_sweeps", s.polish_sweeps, 0, 1000));
     m.param = read_param(r, "parameterization", s.param);
     m.tolerance = read_tolerance(r, ctx, o);
     // With a tolerance, `terms` is the cap (default 8): the greedy search stops
@@ -1472,6 +1479,12 @@ void read_method(Reader& r, Ctx& ctx, const std::string& kind, uint64_t base_see
     o["max_evaluations"] = s.powell.max_evaluations;
     o["seed"] = m.seed;
     // Non-greedy options enter the run id only when set, so greedy runs keep their cache.
+    if (s.strategy != "greedy") {
+      o["strategy"] = s.strategy;
+      o["term_param"] = s.term_param;
+      o["keep"] = s.keep;
+      o["polish_sweeps"] = s.polish_sweeps;
+    }
     if (s.beam != 1) o["beam"] = s.beam;
     if (s.backfit_sweeps != 0) o["backfit_sweeps"] = s.backfit_sweeps;
     if (s.backfit_sweeps != 0 && s.backfit_restarts != 0) o["backfit_restarts"] = s.backfit_restarts;

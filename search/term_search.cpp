@@ -1,6 +1,8 @@
 // Greedy projection search (see term_search.h).
 #include "search/term_search.h"
 
+#include "search/structured_search.h"
+
 #include <nlopt.hpp>
 
 #include <algorithm>
@@ -24,6 +26,25 @@ double now_seconds() {
 }  // namespace
 
 void SearchOptions::validate() const {
+  if (strategy != "structured" && strategy != "greedy")
+    throw std::invalid_argument("strategy: expected \"structured\" or \"greedy\", found \"" + strategy + "\"");
+  if (term_param != "either" && term_param != "fixed")
+    throw std::invalid_argument("term_param: expected \"either\" or \"fixed\", found \"" + term_param + "\"");
+  if (keep < 1) throw std::invalid_argument("keep: expected >= 1, found " + std::to_string(keep));
+  if (polish_sweeps < 0)
+    throw std::invalid_argument("polish_sweeps: expected >= 0, found " + std::to_string(polish_sweeps));
+  if (strategy == "structured") {
+    if (beam != 1)
+      throw std::invalid_argument("beam: the structured strategy has no beam (expected 1, found " +
+                                  std::to_string(beam) + "); beam is an option of strategy = \"greedy\"");
+    if (backfit_sweeps != 0)
+      throw std::invalid_argument("backfit_sweeps: the structured strategy polishes with polish_sweeps "
+                                  "(expected 0, found " + std::to_string(backfit_sweeps) +
+                                  "); backfitting is an option of strategy = \"greedy\"");
+    if (optimizer != "powell")
+      throw std::invalid_argument("optimizer: the structured strategy uses powell, found \"" + optimizer +
+                                  "\"; the nlopt optimizers are options of strategy = \"greedy\"");
+  }
   if (terms < 1) throw std::invalid_argument("terms: expected >= 1, found " + std::to_string(terms));
   if (texture_size < 2 || texture_size > 1024)
     throw std::invalid_argument("texture_size: expected 2..1024, found " +
@@ -34,7 +55,7 @@ void SearchOptions::validate() const {
   if (restarts < 0)
     throw std::invalid_argument("restarts: expected >= 0, found " + std::to_string(restarts));
   for (const auto& g : guesses) guess_rotation(g);  // throws for unknown names
-  if (restarts == 0 && guesses.empty())
+  if (strategy == "greedy" && restarts == 0 && guesses.empty())
     throw std::invalid_argument("restarts: 0 restarts and no guesses leave nothing to search from");
   if (std::find(std::begin(kOptimizers), std::end(kOptimizers), optimizer) == std::end(kOptimizers))
     throw std::invalid_argument("optimizer: expected powell, praxis, bobyqa, neldermead, sbplx, "
@@ -42,7 +63,7 @@ void SearchOptions::validate() const {
   if (threads < 0)
     throw std::invalid_argument("threads: expected >= 0, found " + std::to_string(threads));
   const int starts = restarts + static_cast<int>(guesses.size());
-  if (beam < 1 || beam > starts)
+  if (strategy == "greedy" && (beam < 1 || beam > starts))
     throw std::invalid_argument("beam: expected 1..(restarts + guesses) = 1.." +
                                 std::to_string(starts) + ", found " + std::to_string(beam));
   if (backfit_sweeps < 0)
@@ -364,6 +385,7 @@ double ScheduleObjective::operator()(const Rotation4& r) const {
 
 SearchResult search_factorization(const FitData& data, const SearchOptions& opt) {
   opt.validate();
+  if (opt.strategy == "structured") return structured_search(data, opt);
   const double t0 = now_seconds();
   const int sres = opt.search_texture_size > 0 ? opt.search_texture_size : opt.texture_size;
   SearchResult out;
