@@ -156,6 +156,7 @@ struct BenchSearchArgs {
   std::string term_param = SearchOptions{}.term_param;
   int keep = SearchOptions{}.keep;
   int polish_sweeps = SearchOptions{}.polish_sweeps;
+  int beam_width = SearchOptions{}.beam_width;
 };
 
 SearchOptions bench_search_options(const BenchSearchArgs& a, const std::string& strategy) {
@@ -164,6 +165,7 @@ SearchOptions bench_search_options(const BenchSearchArgs& a, const std::string& 
   opt.term_param = a.term_param;
   opt.keep = a.keep;
   opt.polish_sweeps = a.polish_sweeps;
+  opt.beam_width = a.beam_width;
   opt.terms = a.terms;
   opt.param = parse_parameterization(a.param);
   opt.texture_size = a.texture;
@@ -266,6 +268,9 @@ struct BenchPlantedArgs {
   int texture = 16;
   int restarts = 6;
   int threads = 0;
+  int solve_last = 2;
+  int beam_width = SearchOptions{}.beam_width;
+  int keep = SearchOptions{}.keep;
   std::string strategy = "both";
 };
 
@@ -280,6 +285,7 @@ void run_bench_planted(const BenchPlantedArgs& a) {
                                      : planted_rotation_brdf(i, a.terms, parse_parameterization(a.param));
     const SampleSet s = sample_grid(b, a.grid);
     FitOptions fo;
+    fo.solve_last = a.solve_last;
     const FitData d(s, fo.eps);
     std::vector<TermSpec> truth = b.specs(a.texture);
     std::sort(truth.begin(), truth.end(), [](const TermSpec& x, const TermSpec& y) {
@@ -311,7 +317,15 @@ void run_bench_planted(const BenchPlantedArgs& a) {
       if (a.strategy != "both" && a.strategy != names[k]) continue;
       SearchOptions opt;
       opt.strategy = names[k];
+      // The greedy search reads the planted parameterization (its best case);
+      // the structured one chooses per term.
+      if (a.family == "rotation") opt.param = parse_parameterization(a.param);
       opt.terms = terms;
+      opt.fit.solve_last = a.solve_last;
+      if (k == 1) {
+        opt.beam_width = a.beam_width;
+        opt.keep = a.keep;
+      }
       opt.texture_size = a.texture;
       opt.restarts = a.restarts;
       opt.threads = a.threads;
@@ -319,7 +333,17 @@ void run_bench_planted(const BenchPlantedArgs& a) {
       err[k] = r.rel_mse_after_term.back();
       secs[k] = r.seconds;
       fits[k] = r.evaluations;
-      j[names[k]] = {{"rel_mse", err[k]}, {"evaluations", r.evaluations}, {"seconds", r.seconds}};
+      // Per found term: its parameterization and the distance of its plane to
+      // the nearest true plane of that parameterization (2 - |P P_true^T|^2, 0 = same plane).
+      nlohmann::json found = nlohmann::json::array();
+      for (const FactorTerm& t : r.factorization->terms()) {
+        double dist = 2;
+        for (const PlantedTerm& pt : b.terms())
+          if (pt.param == t.proj.param) dist = std::min(dist, 2 - (t.proj.P * pt.P.transpose()).squaredNorm());
+        found.push_back({{"parameterization", to_string(t.proj.param)}, {"plane_distance", dist}});
+      }
+      j[names[k]] = {{"rel_mse", err[k]},  {"evaluations", r.evaluations}, {"seconds", r.seconds},
+                     {"terms", found}, {"rel_mse_after_term", r.rel_mse_after_term}};
     }
     std::cout << j.dump() << std::endl;
     std::fprintf(stderr, "| %s | %.4g | %.4g | %.4g | %.4g | %.1fx | %.2fx | %d | %d | %.1f | %.1f |\n",
@@ -387,6 +411,8 @@ void add_cmd_bench(CLI::App& app) {
       ->capture_default_str();
   search->add_option("--keep", b->keep, "structured: Powell runs per term (best screened starts)")
       ->capture_default_str();
+  search->add_option("--beam-width", b->beam_width, "structured: configurations kept per step")
+      ->capture_default_str();
   search->add_option("--polish-sweeps", b->polish_sweeps, "structured: joint re-search sweeps at the end")
       ->capture_default_str();
   search->callback([b] { run_bench_search(*b); });
@@ -404,6 +430,9 @@ void add_cmd_bench(CLI::App& app) {
   planted->add_option("--grid", pa->grid, "regular res^4 parabolic grid")->capture_default_str();
   planted->add_option("--texture", pa->texture, "texture resolution (search and floor)")->capture_default_str();
   planted->add_option("--restarts", pa->restarts, "random starts per term")->capture_default_str();
+  planted->add_option("--solve-last", pa->solve_last, "terms solved jointly (n), search and floor")->capture_default_str();
+  planted->add_option("--beam-width", pa->beam_width, "structured: configurations kept per step")->capture_default_str();
+  planted->add_option("--keep", pa->keep, "structured: Powell runs per step")->capture_default_str();
   planted->add_option("--threads", pa->threads, "threads (0 = all cores)")->capture_default_str();
   planted->add_option("--strategy", pa->strategy, "greedy, structured or both")
       ->check(CLI::IsMember({"structured", "greedy", "both"}))

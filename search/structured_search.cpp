@@ -83,16 +83,23 @@ class Structured {
     return out;
   }
   // The fit schedule at the search resolution: its error, and the texels.
-  double schedule(const std::vector<Term>& ts, std::vector<FactorTerm>* done) const;
+  // n: terms solved jointly (0 = the option's solve_last).
+  double schedule(const std::vector<Term>& ts, std::vector<FactorTerm>* done, int n = 0) const;
   // Mean over channels of g minus the given terms' values (the residual log BRDF).
   std::vector<double> residual(const std::vector<FactorTerm>& done) const;
   // Seed plane pairs of a residual, one per allowed parameterization.
   std::vector<std::pair<Parameterization, PlaneSplit>> seeds(const std::vector<double>& y) const;
-  // Searches the term after ts (texels `done`): screened starts, Powell from the best.
-  Term next_term(const std::vector<Term>& ts, const std::vector<FactorTerm>& done,
-                 const std::vector<std::pair<Parameterization, PlaneSplit>>& sd, TermRecord* rec);
+  struct Config {
+    std::vector<Term> ts;
+    std::vector<FactorTerm> done;  // the schedule's texels at the search resolution
+    double value = kInf;
+    int start = 0;                 // index of the start of the last term
+  };
+  // One beam step: the configs after adding term j to each of `beam`.
+  std::vector<Config> step(const std::vector<Config>& beam, int j, TermRecord* rec);
   // Jacobi sweeps over terms [from, J): each re-searched with the others held.
-  void polish(std::vector<Term>& ts, double& value, size_t from, int sweeps, TermRecord* rec);
+  // The objective is the schedule with n terms solved jointly.
+  void polish(std::vector<Term>& ts, double& value, size_t from, int sweeps, int n, TermRecord* rec);
 
   const FitData& d_;
   const SearchOptions& opt_;
@@ -102,8 +109,10 @@ class Structured {
   int evaluations_ = 0;
 };
 
-double Structured::schedule(const std::vector<Term>& ts, std::vector<FactorTerm>* done_out) const {
-  const int n = opt_.fit.solve_last;
+double Structured::schedule(const std::vector<Term>& ts, std::vector<FactorTerm>* done_out, int n) const {
+  FitOptions fo = opt_.fit;
+  if (n > 0) fo.solve_last = n;
+  n = fo.solve_last;
   const std::vector<TermSpec> sp = specs(ts, sres_);
   std::vector<FactorTerm> done;
   double value = kInf;
@@ -112,7 +121,7 @@ double Structured::schedule(const std::vector<Term>& ts, std::vector<FactorTerm>
     std::vector<FactorTerm> fixed(done.begin(), done.begin() + first);
     std::vector<TermSpec> joint(sp.begin() + first, sp.begin() + s + 1);
     try {
-      const JointSolution sol = solve_joint(d_, fixed_sum(d_, fixed), joint, opt_.fit, false);
+      const JointSolution sol = solve_joint(d_, fixed_sum(d_, fixed), joint, fo, false);
       done = fixed;
       done.insert(done.end(), sol.terms.begin(), sol.terms.end());
       value = sol.rel_mse;
@@ -145,81 +154,136 @@ std::vector<std::pair<Parameterization, PlaneSplit>> Structured::seeds(const std
   return out;
 }
 
-Term Structured::next_term(const std::vector<Term>& ts, const std::vector<FactorTerm>& done,
-                           const std::vector<std::pair<Parameterization, PlaneSplit>>& sd, TermRecord* rec) {
+// One step of the beam: every config extended by every screened start; Powell
+// from the `keep` best distinct (config, start) pairs; the new beam is the best
+// refined configs plus the best unrefined seed configs (see the header).
+std::vector<Structured::Config> Structured::step(const std::vector<Config>& beam, int j, TermRecord* rec) {
   const double t0 = now_seconds();
-  const size_t j = ts.size();
-  const size_t first = first_joint(j, opt_.fit.solve_last);
-  const std::vector<FactorTerm> fixed(done.begin(), done.begin() + first);
-  std::vector<TermSpec> known;
-  for (size_t i = first; i < j; ++i) known.push_back(spec(ts[i], sres_));
-  std::vector<std::unique_ptr<TermObjective>> obj(2);
-  for (Parameterization p : params_)
-    obj[pidx(p)] = std::make_unique<TermObjective>(d_, fixed, known, popt_[pidx(p)], sres_);
-
-  // Starts: seeds, guesses (wi, wo and the configured ones), seeded random rotations.
-  std::vector<Start> starts;
-  auto add = [&](const Rotation4& R, Parameterization p) {
-    starts.push_back(Start{Term{R, p}, kInf, static_cast<int>(starts.size())});
+  struct Cand {
+    size_t b;      // beam config extended
+    Start s;       // the start (term, value at the start)
+    bool seed;     // read off the residual's Hessians, or a guess (not a random start)
   };
-  for (const auto& [p, s] : sd) {
-    add(s.first, p);
-    add(s.second, p);
+  std::vector<Cand> cands;
+  // Objectives per (config, parameterization); built once, shared by threads.
+  std::vector<std::array<std::unique_ptr<TermObjective>, 2>> obj(beam.size());
+  for (size_t b = 0; b < beam.size(); ++b) {
+    const Config& c = beam[b];
+    const size_t first = first_joint(j, opt_.fit.solve_last);
+    const std::vector<FactorTerm> fixed(c.done.begin(), c.done.begin() + first);
+    std::vector<TermSpec> known;
+    for (size_t i = first; i < static_cast<size_t>(j); ++i) known.push_back(spec(c.ts[i], sres_));
+    for (Parameterization p : params_)
+      obj[b][pidx(p)] = std::make_unique<TermObjective>(d_, fixed, known, popt_[pidx(p)], sres_);
+    int index = 0;
+    auto add = [&](const Rotation4& R, Parameterization p, bool seed) {
+      cands.push_back(Cand{b, Start{Term{R, p}, kInf, index++}, seed});
+    };
+    for (const auto& [p, sp] : seeds(residual(c.done))) {
+      add(sp.first, p, true);
+      add(sp.second, p, true);
+    }
+    std::vector<std::string> guesses = {"wi", "wo"};
+    for (const std::string& g : opt_.guesses)
+      if (std::find(guesses.begin(), guesses.end(), g) == guesses.end()) guesses.push_back(g);
+    for (Parameterization p : params_)
+      for (const std::string& g : guesses) add(guess_rotation(g), p, true);
+    for (int r = 0; r < opt_.restarts; ++r) {
+      std::mt19937_64 rng(opt_.seed * 1000003ull + j * 7919ull + r);
+      add(Rotation4::random(rng), params_[r % params_.size()], false);
+    }
   }
-  std::vector<std::string> guesses = {"wi", "wo"};
-  for (const std::string& g : opt_.guesses)
-    if (std::find(guesses.begin(), guesses.end(), g) == guesses.end()) guesses.push_back(g);
-  for (Parameterization p : params_)
-    for (const std::string& g : guesses) add(guess_rotation(g), p);
-  for (int r = 0; r < opt_.restarts; ++r) {
-    std::mt19937_64 rng(opt_.seed * 1000003ull + j * 7919ull + r);
-    add(Rotation4::random(rng), params_[r % params_.size()]);
-  }
-  parallel_for(starts.size(), opt_.threads, [&](size_t i) {
-    starts[i].value = (*obj[pidx(starts[i].t.p)])(starts[i].t.R);
+  parallel_for(cands.size(), opt_.threads, [&](size_t i) {
+    Cand& c = cands[i];
+    c.s.value = (*obj[c.b][pidx(c.s.t.p)])(c.s.t.R);
   });
-  evaluations_ += static_cast<int>(starts.size());
-  rec->evaluations += static_cast<int>(starts.size());
+  evaluations_ += static_cast<int>(cands.size());
+  rec->evaluations += static_cast<int>(cands.size());
 
-  // The `keep` best distinct starts (same parameterization and nearly the same plane = duplicate).
-  std::vector<Start> sorted = starts;
-  std::stable_sort(sorted.begin(), sorted.end(), [](const Start& a, const Start& b) { return a.value < b.value; });
-  std::vector<Start> kept;
-  for (const Start& s : sorted) {
-    if (static_cast<int>(kept.size()) >= opt_.keep) break;
-    if (!std::isfinite(s.value)) continue;
-    bool dup = false;
-    for (const Start& k : kept)
-      dup = dup || (k.t.p == s.t.p && plane_distance(k.t.R, s.t.R) < 0.02);
-    if (!dup) kept.push_back(s);
-  }
-  if (kept.empty()) kept.push_back(sorted.front());
-  std::vector<PowellResult> res(kept.size());
-  parallel_for(kept.size(), opt_.threads, [&](size_t i) {
-    res[i] = powell_minimize(std::cref(*obj[pidx(kept[i].t.p)]), kept[i].t.R, opt_.powell);
+  std::vector<size_t> order(cands.size());
+  for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(),
+                   [&](size_t a, size_t b) { return cands[a].s.value < cands[b].s.value; });
+  const auto distinct = [&](const std::vector<size_t>& chosen, size_t i) {
+    for (size_t k : chosen)
+      if (cands[k].b == cands[i].b && cands[k].s.t.p == cands[i].s.t.p &&
+          plane_distance(cands[k].s.t.R, cands[i].s.t.R) < 0.02)
+        return false;
+    return std::isfinite(cands[i].s.value);
+  };
+  std::vector<size_t> refine;
+  for (size_t i : order)
+    if (static_cast<int>(refine.size()) < opt_.keep && distinct(refine, i)) refine.push_back(i);
+  std::vector<PowellResult> res(refine.size());
+  parallel_for(refine.size(), opt_.threads, [&](size_t k) {
+    const Cand& c = cands[refine[k]];
+    res[k] = powell_minimize(std::cref(*obj[c.b][pidx(c.s.t.p)]), c.s.t.R, opt_.powell);
   });
-  size_t best = 0;
-  for (size_t i = 0; i < res.size(); ++i) {
-    evaluations_ += res[i].evaluations;
-    rec->evaluations += res[i].evaluations;
-    if (res[i].value < res[best].value) best = i;
+  for (const PowellResult& r : res) {
+    evaluations_ += r.evaluations;
+    rec->evaluations += r.evaluations;
   }
-  rec->best_start = kept[best].index;
-  rec->search_rel_mse = res[best].value;
+  // New beam: refined configs first (best ceil(B/2)), then unrefined seed
+  // configs (the planes read off the data, kept even when a single term
+  // refined elsewhere fits better: the trap of the greedy search), then
+  // anything else, by value.
+  struct Next {
+    size_t b;
+    Term t;
+    double value;
+    int start;
+  };
+  std::vector<Next> refined, seeds_next, others;
+  for (size_t k = 0; k < refine.size(); ++k)
+    refined.push_back({cands[refine[k]].b, Term{res[k].best.normalized(), cands[refine[k]].s.t.p}, res[k].value,
+                       cands[refine[k]].s.index});
+  std::stable_sort(refined.begin(), refined.end(), [](const Next& a, const Next& b) { return a.value < b.value; });
+  std::vector<size_t> taken_seeds;
+  for (size_t i : order) {
+    if (!distinct(taken_seeds, i)) continue;
+    taken_seeds.push_back(i);
+    (cands[i].seed ? seeds_next : others).push_back({cands[i].b, cands[i].s.t, cands[i].s.value, cands[i].s.index});
+  }
+  const size_t B = static_cast<size_t>(opt_.beam_width);
+  std::vector<Next> chosen;
+  for (size_t k = 0; k < refined.size() && chosen.size() < (B + 1) / 2; ++k) chosen.push_back(refined[k]);
+  for (const Next& n : seeds_next)
+    if (chosen.size() < B) chosen.push_back(n);
+  for (const Next& n : refined)
+    if (chosen.size() < B && std::find_if(chosen.begin(), chosen.end(), [&](const Next& c) {
+                               return &c != &n && c.b == n.b && c.start == n.start && c.value == n.value;
+                             }) == chosen.end())
+      chosen.push_back(n);
+  for (const Next& n : others)
+    if (chosen.size() < B) chosen.push_back(n);
+  std::vector<Config> out;
+  for (const Next& n : chosen) {
+    Config c;
+    c.ts = beam[n.b].ts;
+    c.ts.push_back(n.t);
+    c.value = schedule(c.ts, &c.done);
+    c.start = n.start;
+    ++evaluations_;
+    ++rec->evaluations;
+    if (std::isfinite(c.value)) out.push_back(std::move(c));
+  }
+  std::stable_sort(out.begin(), out.end(), [](const Config& a, const Config& b) { return a.value < b.value; });
   rec->seconds += now_seconds() - t0;
-  return Term{res[best].best.normalized(), kept[best].t.p};
+  return out;
 }
 
-void Structured::polish(std::vector<Term>& ts, double& value, size_t from, int sweeps, TermRecord* rec) {
+void Structured::polish(std::vector<Term>& ts, double& value, size_t from, int sweeps, int n, TermRecord* rec) {
   const double t0 = now_seconds();
   const size_t J = ts.size();
+  SearchOptions po[2] = {popt_[0], popt_[1]};
+  po[0].fit.solve_last = po[1].fit.solve_last = n;
   for (int sweep = 0; sweep < sweeps; ++sweep) {
     // Each term re-searched from its rotation with the others held (in parallel).
     const std::vector<TermSpec> sp = specs(ts, sres_);
     std::vector<PowellResult> res(J);
     parallel_for(J - from, opt_.threads, [&](size_t k) {
       const size_t i = from + k;
-      const ScheduleObjective objective(d_, sp, i, popt_[pidx(ts[i].p)], sres_);
+      const ScheduleObjective objective(d_, sp, i, po[pidx(ts[i].p)], sres_);
       res[i] = powell_minimize(std::cref(objective), ts[i].R, opt_.powell);
     });
     std::vector<size_t> order;
@@ -234,7 +298,7 @@ void Structured::polish(std::vector<Term>& ts, double& value, size_t from, int s
     for (size_t i : order) {  // best move first; each checked on the current schedule
       std::vector<Term> trial = ts;
       trial[i].R = res[i].best.normalized();
-      const double v = schedule(trial, nullptr);
+      const double v = schedule(trial, nullptr, n);
       ++evaluations_;
       ++rec->backfit_evaluations;
       if (v < value * (1 - 1e-9)) {
@@ -252,75 +316,48 @@ void Structured::polish(std::vector<Term>& ts, double& value, size_t from, int s
 SearchResult Structured::run() {
   const double t0 = now_seconds();
   SearchResult out;
-  std::vector<Term> ts;
-  std::vector<FactorTerm> done;
+  std::vector<Config> beam(1);
+  beam[0].value = kInf;
   std::vector<TermRecord> records;
-  double value = kInf;
-  // Seed pairs of the residual after terms 1..i, i = 0, 1, ... (kept for the pair move).
-  std::vector<std::vector<std::pair<Parameterization, PlaneSplit>>> seed_at;
   std::shared_ptr<HomomorphicFactorization> f;
   std::vector<double> errors;
-  const auto refit = [&] {
+  const auto refit = [&](const std::vector<Term>& ts) {
     errors.clear();
-    f = fit_homomorphic(d_, specs(ts, opt_.texture_size), opt_.fit, "search", &errors);
+    FitOptions fo = opt_.fit;
+    // The joint refit: every term solved together (the schedule's solution is
+    // one point of that problem, so its least-squares error is never higher).
+    if (opt_.final_joint) fo.solve_last = std::max(fo.solve_last, static_cast<int>(ts.size()));
+    f = fit_homomorphic(d_, specs(ts, opt_.texture_size), fo, "search", &errors);
   };
   for (int j = 0; j < opt_.terms; ++j) {
-    seed_at.push_back(seeds(residual(done)));
     TermRecord rec;
-    const Term t = next_term(ts, done, seed_at.back(), &rec);
-    std::vector<Term> greedy = ts;
-    greedy.push_back(t);
-    std::vector<FactorTerm> greedy_done;
-    double greedy_value = schedule(greedy, &greedy_done);
-    ++evaluations_;
-    if (j >= 1) {
-      // Pair move: terms j-1 and j from the seed pair of the residual of terms 1..j-2.
-      const std::vector<Term> base(ts.begin(), ts.end() - 1);
-      std::vector<Term> best_pair;
-      double best_pair_value = kInf;
-      for (const auto& [p, s] : seed_at[j - 1]) {
-        std::vector<Term> pair = base;
-        pair.push_back(Term{s.first, p});
-        pair.push_back(Term{s.second, p});
-        const double v = schedule(pair, nullptr);
-        ++evaluations_;
-        if (v < best_pair_value) {
-          best_pair_value = v;
-          best_pair = pair;
-        }
-      }
-      if (!best_pair.empty()) {
-        polish(best_pair, best_pair_value, j - 1, opt_.polish_sweeps + 1, &rec);
-        // Polish the greedy pair as much, so the comparison is fair.
-        polish(greedy, greedy_value, j - 1, opt_.polish_sweeps + 1, &rec);
-        if (best_pair_value < greedy_value) {
-          greedy = best_pair;
-          greedy_value = schedule(greedy, &greedy_done);
-          ++evaluations_;
-          records.back().rotation = greedy[j - 1].R.packed();
-        } else {
-          schedule(greedy, &greedy_done);
-          ++evaluations_;
-        }
-      }
-    }
-    ts = std::move(greedy);
-    done = std::move(greedy_done);
-    value = greedy_value;
-    rec.rotation = ts.back().R.packed();
-    rec.search_rel_mse = value;
+    std::vector<Config> next = step(beam, j, &rec);
+    if (next.empty()) throw std::runtime_error("structured search: every start of term " + std::to_string(j + 1) +
+                                               " failed to solve");
+    beam = std::move(next);
+    rec.rotation = beam[0].ts.back().R.packed();
+    rec.search_rel_mse = beam[0].value;
+    rec.best_start = beam[0].start;
     records.push_back(rec);
     if (opt_.stop_after_term && j + 1 < opt_.terms) {
-      refit();
+      refit(beam[0].ts);
       if (opt_.stop_after_term(*f)) break;
     }
   }
-  if (ts.size() >= 2) {
-    polish(ts, value, 0, opt_.polish_sweeps, &records.back());
-    for (size_t i = 0; i < ts.size(); ++i) records[i].rotation = ts[i].R.packed();
-    records.back().search_rel_mse = value;
+  std::vector<Term> ts = beam[0].ts;
+  double value = beam[0].value;
+  if (ts.size() >= 2 && opt_.polish_sweeps > 0) {
+    // Small searches polish under the joint objective their refit uses.
+    const int J = static_cast<int>(ts.size());
+    const int n = opt_.final_joint && J <= opt_.joint_polish_terms ? std::max(J, opt_.fit.solve_last)
+                                                                   : opt_.fit.solve_last;
+    value = schedule(ts, nullptr, n);
+    ++evaluations_;
+    polish(ts, value, 0, opt_.polish_sweeps, n, &records.back());
   }
-  refit();
+  for (size_t i = 0; i < ts.size(); ++i) records[i].rotation = ts[i].R.packed();
+  records.back().search_rel_mse = value;
+  refit(ts);
   out.factorization = f;
   out.rel_mse_after_term = errors;
   out.terms = records;

@@ -31,6 +31,9 @@ void SearchOptions::validate() const {
   if (term_param != "either" && term_param != "fixed")
     throw std::invalid_argument("term_param: expected \"either\" or \"fixed\", found \"" + term_param + "\"");
   if (keep < 1) throw std::invalid_argument("keep: expected >= 1, found " + std::to_string(keep));
+  if (beam_width < 1) throw std::invalid_argument("beam_width: expected >= 1, found " + std::to_string(beam_width));
+  if (joint_polish_terms < 0)
+    throw std::invalid_argument("joint_polish_terms: expected >= 0, found " + std::to_string(joint_polish_terms));
   if (polish_sweeps < 0)
     throw std::invalid_argument("polish_sweeps: expected >= 0, found " + std::to_string(polish_sweeps));
   if (strategy == "structured") {
