@@ -117,7 +117,7 @@ const std::map<std::string, std::vector<std::string>>& key_table() {
                    "reciprocity", "optimizer", "ftol", "line_tol", "initial_step", "max_sweeps",
                    "max_evaluations", "threads", "seed", "beam", "backfit_sweeps",
                    "backfit_restarts", "tolerance", "strategy", "term_param", "keep",
-                   "polish_sweeps"}})},
+                   "polish_sweeps", "beam_width", "final_joint", "joint_polish_terms"}})},
       {"method:svd", join_keys({kCommonMethodKeys,
                                 {"texture_size", "terms", "parameterization", "log", "eps",
                                  "subtract_eps", "rim_inset", "extend_below_horizon",
@@ -1414,6 +1414,9 @@ void read_method(Reader& r, Ctx& ctx, const std::string& kind, uint64_t base_see
     s.term_param = r.choice("term_param", s.term_param, {"either", "fixed"});
     s.keep = static_cast<int>(r.integer("keep", s.keep, 1, 1000));
     s.polish_sweeps = static_cast<int>(r.integer("polish_sweeps", s.polish_sweeps, 0, 1000));
+    s.beam_width = static_cast<int>(r.integer("beam_width", s.beam_width, 1, 1000));
+    s.final_joint = r.boolean("final_joint", s.final_joint);
+    s.joint_polish_terms = static_cast<int>(r.integer("joint_polish_terms", s.joint_polish_terms, 0, 64));
     m.param = read_param(r, "parameterization", s.param);
     m.tolerance = read_tolerance(r, ctx, o);
     // With a tolerance, `terms` is the cap (default 8): the greedy search stops
@@ -1484,6 +1487,9 @@ void read_method(Reader& r, Ctx& ctx, const std::string& kind, uint64_t base_see
       o["term_param"] = s.term_param;
       o["keep"] = s.keep;
       o["polish_sweeps"] = s.polish_sweeps;
+      o["beam_width"] = s.beam_width;
+      o["final_joint"] = s.final_joint;
+      o["joint_polish_terms"] = s.joint_polish_terms;
     }
     if (s.beam != 1) o["beam"] = s.beam;
     if (s.backfit_sweeps != 0) o["backfit_sweeps"] = s.backfit_sweeps;

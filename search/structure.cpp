@@ -118,9 +118,9 @@ void block_energies(const std::vector<Eigen::Matrix4d>& hs, const Eigen::Matrix4
 
 PlaneSplit split_planes(const std::vector<Eigen::Matrix4d>& hessians) {
   if (hessians.empty()) throw std::invalid_argument("split_planes: no Hessians (too few samples?)");
-  // Powell runs on a subset (the objective is a sum; 400 terms pin it well).
+  // Powell runs on a subset (the objective is a sum; 200 terms pin it well).
   std::vector<Eigen::Matrix4d> hs;
-  const size_t stride = std::max<size_t>(1, hessians.size() / 400);
+  const size_t stride = std::max<size_t>(1, hessians.size() / 200);
   for (size_t k = 0; k < hessians.size(); k += stride) hs.push_back(hessians[k]);
   double total = 0;
   Eigen::Matrix4d M = Eigen::Matrix4d::Zero();
@@ -137,22 +137,26 @@ PlaneSplit split_planes(const std::vector<Eigen::Matrix4d>& hessians) {
     block_energies(hs, R.normalized().matrix(), &o, &a);
     return o / total;
   };
+  // The three pairings of the eigenvectors; Powell polishes the best one
+  // (near-degenerate eigenvalues mix the planes' eigenvectors, which Powell undoes).
   PowellOptions po;
-  po.ftol = 1e-7;
-  po.line_tol = 1e-4;
-  po.max_evaluations = 4000;
+  po.ftol = 1e-6;
+  po.line_tol = 1e-3;
+  po.max_evaluations = 1500;
   PlaneSplit best;
-  double best_value = std::numeric_limits<double>::infinity();
+  double best_start = std::numeric_limits<double>::infinity();
   for (const auto& p : pairings) {
     Eigen::Matrix4d Q;
     for (int c = 0; c < 4; ++c) Q.col(c) = V.col(p[c]);
     if (Q.determinant() < 0) Q.col(3) = -Q.col(3);
-    const PowellResult r = powell_minimize(objective, Rotation4::from_matrix(Q), po);
-    if (r.value < best_value) {
-      best_value = r.value;
-      best.first = r.best.normalized();
+    const Rotation4 R = Rotation4::from_matrix(Q);
+    const double v = objective(R);
+    if (v < best_start) {
+      best_start = v;
+      best.first = R;
     }
   }
+  best.first = powell_minimize(objective, best.first, po).best.normalized();
   Eigen::Matrix4d Q = best.first.matrix();
   double off, a;
   block_energies(hessians, Q, &off, &a);

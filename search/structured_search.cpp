@@ -5,6 +5,8 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <limits>
 #include <thread>
 
@@ -96,7 +98,8 @@ class Structured {
     int start = 0;                 // index of the start of the last term
   };
   // One beam step: the configs after adding term j to each of `beam`.
-  std::vector<Config> step(const std::vector<Config>& beam, int j, TermRecord* rec);
+  // n: terms solved jointly in this step's objective.
+  std::vector<Config> step(const std::vector<Config>& beam, int j, int n, TermRecord* rec);
   // Jacobi sweeps over terms [from, J): each re-searched with the others held.
   // The objective is the schedule with n terms solved jointly.
   void polish(std::vector<Term>& ts, double& value, size_t from, int sweeps, int n, TermRecord* rec);
@@ -157,7 +160,7 @@ std::vector<std::pair<Parameterization, PlaneSplit>> Structured::seeds(const std
 // One step of the beam: every config extended by every screened start; Powell
 // from the `keep` best distinct (config, start) pairs; the new beam is the best
 // refined configs plus the best unrefined seed configs (see the header).
-std::vector<Structured::Config> Structured::step(const std::vector<Config>& beam, int j, TermRecord* rec) {
+std::vector<Structured::Config> Structured::step(const std::vector<Config>& beam, int j, int n, TermRecord* rec) {
   const double t0 = now_seconds();
   struct Cand {
     size_t b;      // beam config extended
@@ -167,9 +170,12 @@ std::vector<Structured::Config> Structured::step(const std::vector<Config>& beam
   std::vector<Cand> cands;
   // Objectives per (config, parameterization); built once, shared by threads.
   std::vector<std::array<std::unique_ptr<TermObjective>, 2>> obj(beam.size());
+  // The configs' seed planes, in parallel (independent; results by index).
+  std::vector<std::vector<std::pair<Parameterization, PlaneSplit>>> seed_of(beam.size());
+  parallel_for(beam.size(), opt_.threads, [&](size_t b) { seed_of[b] = seeds(residual(beam[b].done)); });
   for (size_t b = 0; b < beam.size(); ++b) {
     const Config& c = beam[b];
-    const size_t first = first_joint(j, opt_.fit.solve_last);
+    const size_t first = first_joint(j, n);
     const std::vector<FactorTerm> fixed(c.done.begin(), c.done.begin() + first);
     std::vector<TermSpec> known;
     for (size_t i = first; i < static_cast<size_t>(j); ++i) known.push_back(spec(c.ts[i], sres_));
@@ -179,7 +185,7 @@ std::vector<Structured::Config> Structured::step(const std::vector<Config>& beam
     auto add = [&](const Rotation4& R, Parameterization p, bool seed) {
       cands.push_back(Cand{b, Start{Term{R, p}, kInf, index++}, seed});
     };
-    for (const auto& [p, sp] : seeds(residual(c.done))) {
+    for (const auto& [p, sp] : seed_of[b]) {
       add(sp.first, p, true);
       add(sp.second, p, true);
     }
@@ -246,28 +252,49 @@ std::vector<Structured::Config> Structured::step(const std::vector<Config>& beam
   }
   const size_t B = static_cast<size_t>(opt_.beam_width);
   std::vector<Next> chosen;
-  for (size_t k = 0; k < refined.size() && chosen.size() < (B + 1) / 2; ++k) chosen.push_back(refined[k]);
-  for (const Next& n : seeds_next)
-    if (chosen.size() < B) chosen.push_back(n);
-  for (const Next& n : refined)
-    if (chosen.size() < B && std::find_if(chosen.begin(), chosen.end(), [&](const Next& c) {
-                               return &c != &n && c.b == n.b && c.start == n.start && c.value == n.value;
-                             }) == chosen.end())
-      chosen.push_back(n);
-  for (const Next& n : others)
-    if (chosen.size() < B) chosen.push_back(n);
+  // A configuration already chosen (same parameterizations, same planes in
+  // order, whatever start or parent it came from) is not taken twice.
+  const auto same = [&](const Next& x, const Next& y) {
+    const std::vector<Term>&tx = beam[x.b].ts, &ty = beam[y.b].ts;
+    if (x.t.p != y.t.p || plane_distance(x.t.R, y.t.R) >= 0.02) return false;
+    for (size_t i = 0; i < tx.size(); ++i)
+      if (tx[i].p != ty[i].p || plane_distance(tx[i].R, ty[i].R) >= 0.02) return false;
+    return true;
+  };
+  const auto take = [&](const Next& x, size_t limit) {
+    if (chosen.size() >= limit) return;
+    for (const Next& c : chosen)
+      if (same(c, x)) return;
+    chosen.push_back(x);
+  };
+  for (const Next& x : refined) take(x, (B + 1) / 2);
+  for (const Next& x : seeds_next) take(x, B);
+  for (const Next& x : refined) take(x, B);
+  for (const Next& x : others) take(x, B);
   std::vector<Config> out;
-  for (const Next& n : chosen) {
+  for (const Next& x : chosen) {
     Config c;
-    c.ts = beam[n.b].ts;
-    c.ts.push_back(n.t);
-    c.value = schedule(c.ts, &c.done);
-    c.start = n.start;
+    c.ts = beam[x.b].ts;
+    c.ts.push_back(x.t);
+    c.value = schedule(c.ts, &c.done, n);
+    c.start = x.start;
     ++evaluations_;
     ++rec->evaluations;
     if (std::isfinite(c.value)) out.push_back(std::move(c));
   }
   std::stable_sort(out.begin(), out.end(), [](const Config& a, const Config& b) { return a.value < b.value; });
+  if (std::getenv("BF_DEBUG_BEAM")) {
+    for (const Config& c : out) {
+      std::fprintf(stderr, "step %d value %.5g:", j, c.value);
+      for (const Term& t : c.ts) {
+        const Eigen::Matrix4d M = t.R.matrix();
+        std::fprintf(stderr, " %s[%.2f %.2f|%.2f %.2f]", t.p == Parameterization::WiWo ? "w" : "h",
+                     M.block<2, 2>(0, 0).squaredNorm(), M.block<2, 2>(2, 0).squaredNorm(),
+                     M.block<2, 2>(0, 0).squaredNorm(), M.block<2, 2>(2, 0).squaredNorm());
+      }
+      std::fprintf(stderr, "\n");
+    }
+  }
   rec->seconds += now_seconds() - t0;
   return out;
 }
@@ -283,8 +310,18 @@ void Structured::polish(std::vector<Term>& ts, double& value, size_t from, int s
     std::vector<PowellResult> res(J);
     parallel_for(J - from, opt_.threads, [&](size_t k) {
       const size_t i = from + k;
-      const ScheduleObjective objective(d_, sp, i, po[pidx(ts[i].p)], sres_);
-      res[i] = powell_minimize(std::cref(objective), ts[i].R, opt_.powell);
+      if (static_cast<size_t>(n) >= J) {
+        // All terms joint: the objective is one solve with term i last, so the
+        // other terms' part of the normal matrix is built once (TermObjective).
+        std::vector<TermSpec> others;
+        for (size_t k2 = 0; k2 < J; ++k2)
+          if (k2 != i) others.push_back(sp[k2]);
+        const TermObjective objective(d_, {}, others, po[pidx(ts[i].p)], sres_);
+        res[i] = powell_minimize(std::cref(objective), ts[i].R, opt_.powell);
+      } else {
+        const ScheduleObjective objective(d_, sp, i, po[pidx(ts[i].p)], sres_);
+        res[i] = powell_minimize(std::cref(objective), ts[i].R, opt_.powell);
+      }
     });
     std::vector<size_t> order;
     for (size_t i = from; i < J; ++i) {
@@ -329,9 +366,15 @@ SearchResult Structured::run() {
     if (opt_.final_joint) fo.solve_last = std::max(fo.solve_last, static_cast<int>(ts.size()));
     f = fit_homomorphic(d_, specs(ts, opt_.texture_size), fo, "search", &errors);
   };
+  // Small searches are polished and refitted under the joint objective (all
+  // terms solved together); their last term is searched under it too (the
+  // schedule's n = 2 ranking need not be the joint one's, e.g. on McCool's form).
+  const int n_final = opt_.final_joint && opt_.terms <= opt_.joint_polish_terms
+                          ? std::max(opt_.terms, opt_.fit.solve_last)
+                          : opt_.fit.solve_last;
   for (int j = 0; j < opt_.terms; ++j) {
     TermRecord rec;
-    std::vector<Config> next = step(beam, j, &rec);
+    std::vector<Config> next = step(beam, j, j + 1 == opt_.terms ? n_final : opt_.fit.solve_last, &rec);
     if (next.empty()) throw std::runtime_error("structured search: every start of term " + std::to_string(j + 1) +
                                                " failed to solve");
     beam = std::move(next);
@@ -346,14 +389,14 @@ SearchResult Structured::run() {
   }
   std::vector<Term> ts = beam[0].ts;
   double value = beam[0].value;
-  if (ts.size() >= 2 && opt_.polish_sweeps > 0) {
-    // Small searches polish under the joint objective their refit uses.
-    const int J = static_cast<int>(ts.size());
-    const int n = opt_.final_joint && J <= opt_.joint_polish_terms ? std::max(J, opt_.fit.solve_last)
-                                                                   : opt_.fit.solve_last;
-    value = schedule(ts, nullptr, n);
-    ++evaluations_;
-    polish(ts, value, 0, opt_.polish_sweeps, n, &records.back());
+  const int J = static_cast<int>(ts.size());
+  // A stopping rule may end the search early: its configs were scored with solve_last.
+  const int n = J == opt_.terms ? n_final : opt_.fit.solve_last;
+  if (J >= 2 && opt_.polish_sweeps > 0) {
+    // Under the schedule's objective, re-searching an early term re-solves every
+    // later step; only the last solve's terms are polished there.
+    const size_t from = n >= J ? 0 : static_cast<size_t>(J - n);
+    polish(ts, value, from, opt_.polish_sweeps, n, &records.back());
   }
   for (size_t i = 0; i < ts.size(); ++i) records[i].rotation = ts[i].R.packed();
   records.back().search_rel_mse = value;
