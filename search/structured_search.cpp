@@ -5,8 +5,6 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 #include <limits>
 #include <thread>
 
@@ -283,18 +281,6 @@ std::vector<Structured::Config> Structured::step(const std::vector<Config>& beam
     if (std::isfinite(c.value)) out.push_back(std::move(c));
   }
   std::stable_sort(out.begin(), out.end(), [](const Config& a, const Config& b) { return a.value < b.value; });
-  if (std::getenv("BF_DEBUG_BEAM")) {
-    for (const Config& c : out) {
-      std::fprintf(stderr, "step %d value %.5g:", j, c.value);
-      for (const Term& t : c.ts) {
-        const Eigen::Matrix4d M = t.R.matrix();
-        std::fprintf(stderr, " %s[%.2f %.2f|%.2f %.2f]", t.p == Parameterization::WiWo ? "w" : "h",
-                     M.block<2, 2>(0, 0).squaredNorm(), M.block<2, 2>(2, 0).squaredNorm(),
-                     M.block<2, 2>(0, 0).squaredNorm(), M.block<2, 2>(2, 0).squaredNorm());
-      }
-      std::fprintf(stderr, "\n");
-    }
-  }
   rec->seconds += now_seconds() - t0;
   return out;
 }
