@@ -266,6 +266,15 @@ std::vector<Structured::Config> Structured::step(const std::vector<Config>& beam
     chosen.push_back(x);
   };
   for (const Next& x : refined) take(x, (B + 1) / 2);
+  // Every parent configuration (best first) keeps its best seed or guess
+  // extension, so a good partial configuration is not crowded out by the
+  // extensions of another one.
+  for (size_t b = 0; b < beam.size(); ++b)
+    for (const Next& x : seeds_next)
+      if (x.b == b) {
+        take(x, B);
+        break;
+      }
   for (const Next& x : seeds_next) take(x, B);
   for (const Next& x : refined) take(x, B);
   for (const Next& x : others) take(x, B);
