@@ -14,6 +14,7 @@
 #include "experiments/commands.h"
 #include "factor/homomorphic_fit.h"
 #include "search/rotation4.h"
+#include "search/planted.h"
 #include "search/term_search.h"
 #include "solvers/parallel.h"
 
@@ -152,12 +153,20 @@ struct BenchSearchArgs {
   int beam = 1;
   int backfit_sweeps = 0;
   int backfit_restarts = 0;
+  std::string strategy = "structured";  // or "greedy", or "both" (side by side)
+  std::string term_param = SearchOptions{}.term_param;
+  int keep = SearchOptions{}.keep;
+  int polish_sweeps = SearchOptions{}.polish_sweeps;
+  int beam_width = SearchOptions{}.beam_width;
 };
 
-void run_bench_search(const BenchSearchArgs& a) {
-  const BrdfPtr brdf = Catalogue::builtin().make(a.brdf);
-  const SampleSet s = sample_grid(*brdf, a.grid);
+SearchOptions bench_search_options(const BenchSearchArgs& a, const std::string& strategy) {
   SearchOptions opt;
+  opt.strategy = strategy;
+  opt.term_param = a.term_param;
+  opt.keep = a.keep;
+  opt.polish_sweeps = a.polish_sweeps;
+  opt.beam_width = a.beam_width;
   opt.terms = a.terms;
   opt.param = parse_parameterization(a.param);
   opt.texture_size = a.texture;
@@ -175,12 +184,18 @@ void run_bench_search(const BenchSearchArgs& a) {
   opt.beam = a.beam;
   opt.backfit_sweeps = a.backfit_sweeps;
   opt.backfit_restarts = a.backfit_restarts;
-  const FitData d(s, opt.fit.eps);
+  return opt;
+}
+
+// One search, as a JSON line; returns the line's object.
+nlohmann::json bench_one_search(const BenchSearchArgs& a, const FitData& d, const std::string& strategy) {
+  const SearchOptions opt = bench_search_options(a, strategy);
   const std::clock_t c0 = std::clock();
   const SearchResult r = search_factorization(d, opt);
   const double cpu = double(std::clock() - c0) / CLOCKS_PER_SEC;
   nlohmann::json j;
   j["bench"] = "search";
+  j["strategy"] = strategy;
   j["brdf"] = a.brdf;
   j["parameterization"] = a.param;
   j["reciprocity"] = a.reciprocity;
@@ -210,7 +225,132 @@ void run_bench_search(const BenchSearchArgs& a) {
                    {"search_rel_mse", t.search_rel_mse}, {"best_start", t.best_start},
                    {"backfit_evaluations", t.backfit_evaluations}, {"backfit_moves", t.backfit_moves}});
   j["per_term"] = per;
+  nlohmann::json params = nlohmann::json::array();
+  for (const FactorTerm& t : r.factorization->terms()) params.push_back(to_string(t.proj.param));
+  j["term_parameterizations"] = params;
   std::cout << j.dump() << std::endl;
+  return j;
+}
+
+void run_bench_search(const BenchSearchArgs& a) {
+  const BrdfPtr brdf = Catalogue::builtin().make(a.brdf);
+  const SampleSet s = sample_grid(*brdf, a.grid);
+  const FitData d(s, FitOptions{}.eps);
+  if (a.strategy != "both") {
+    bench_one_search(a, d, a.strategy);
+    return;
+  }
+  const nlohmann::json o = bench_one_search(a, d, "greedy");
+  const nlohmann::json n = bench_one_search(a, d, "structured");
+  // Side by side (stderr; stdout keeps the JSON lines).
+  std::fprintf(stderr, "%-5s | %10s %9s %10s | %10s %9s %10s\n", "term", "greedy fits", "seconds",
+               "rel_mse", "struct fits", "seconds", "rel_mse");
+  for (size_t t = 0; t < o["per_term"].size() && t < n["per_term"].size(); ++t) {
+    const auto& po = o["per_term"][t];
+    const auto& pn = n["per_term"][t];
+    std::fprintf(stderr, "%-5zu | %10d %9.2f %10.4g | %10d %9.2f %10.4g\n", t + 1,
+                 po["evaluations"].get<int>() + po["backfit_evaluations"].get<int>(),
+                 po["seconds"].get<double>(), o["rel_mse_after_term"][t].get<double>(),
+                 pn["evaluations"].get<int>() + pn["backfit_evaluations"].get<int>(),
+                 pn["seconds"].get<double>(), n["rel_mse_after_term"][t].get<double>());
+  }
+  std::fprintf(stderr, "%-5s | %10d %9.2f %10.4g | %10d %9.2f %10.4g\n", "all", o["evaluations"].get<int>(),
+               o["seconds"].get<double>(), o["rel_mse_after_term"].back().get<double>(),
+               n["evaluations"].get<int>(), n["seconds"].get<double>(),
+               n["rel_mse_after_term"].back().get<double>());
+}
+struct BenchPlantedArgs {
+  std::string family = "rotation";  // or "mccool"
+  int count = 8;
+  int first = 0;
+  int terms = 2;
+  std::string param = "wiwo";
+  int grid = 16;
+  int texture = 16;
+  int restarts = 6;
+  int threads = 0;
+  int solve_last = 2;
+  int beam_width = SearchOptions{}.beam_width;
+  int keep = SearchOptions{}.keep;
+  std::string strategy = "both";
+};
+
+// The planted family: per member, McCool's error, the greedy and the
+// structured search, and the floor (fit at the true projections, best order).
+void run_bench_planted(const BenchPlantedArgs& a) {
+  std::fprintf(stderr, "| member | McCool | greedy | structured | floor | greedy/floor | structured/floor | fits greedy | fits structured | s greedy | s structured |\n");
+  std::fprintf(stderr, "|---|---|---|---|---|---|---|---|---|---|---|\n");
+  for (int i = a.first; i < a.first + a.count; ++i) {
+    const PlantedProductBrdf b = a.family == "mccool"
+                                     ? planted_mccool_brdf(i)
+                                     : planted_rotation_brdf(i, a.terms, parse_parameterization(a.param));
+    const SampleSet s = sample_grid(b, a.grid);
+    FitOptions fo;
+    fo.solve_last = a.solve_last;
+    const FitData d(s, fo.eps);
+    std::vector<TermSpec> truth = b.specs(a.texture);
+    std::sort(truth.begin(), truth.end(), [](const TermSpec& x, const TermSpec& y) {
+      return std::lexicographical_compare(x.proj.P.data(), x.proj.P.data() + 8, y.proj.P.data(), y.proj.P.data() + 8);
+    });
+    double floor = std::numeric_limits<double>::infinity();
+    do {
+      std::vector<double> e;
+      fit_homomorphic(d, truth, fo, "fit", &e);
+      floor = std::min(floor, e.back());
+    } while (std::next_permutation(truth.begin(), truth.end(), [](const TermSpec& x, const TermSpec& y) {
+      return std::lexicographical_compare(x.proj.P.data(), x.proj.P.data() + 8, y.proj.P.data(), y.proj.P.data() + 8);
+    }));
+    std::vector<double> em;
+    fit_homomorphic(d, mccool_terms(a.texture), fo, "mccool", &em);
+    const int terms = a.family == "mccool" ? 3 : a.terms;
+    nlohmann::json j;
+    j["bench"] = "planted";
+    j["brdf"] = b.to_string();
+    j["samples"] = d.size();
+    j["texture"] = a.texture;
+    j["terms"] = terms;
+    j["mccool"] = em.back();
+    j["floor"] = floor;
+    double err[2] = {NAN, NAN}, secs[2] = {NAN, NAN};
+    int fits[2] = {0, 0};
+    const char* names[2] = {"greedy", "structured"};
+    for (int k = 0; k < 2; ++k) {
+      if (a.strategy != "both" && a.strategy != names[k]) continue;
+      SearchOptions opt;
+      opt.strategy = names[k];
+      // The greedy search reads the planted parameterization (its best case);
+      // the structured one chooses per term.
+      if (a.family == "rotation") opt.param = parse_parameterization(a.param);
+      opt.terms = terms;
+      opt.fit.solve_last = a.solve_last;
+      if (k == 1) {
+        opt.beam_width = a.beam_width;
+        opt.keep = a.keep;
+      }
+      opt.texture_size = a.texture;
+      opt.restarts = a.restarts;
+      opt.threads = a.threads;
+      const SearchResult r = search_factorization(d, opt);
+      err[k] = r.rel_mse_after_term.back();
+      secs[k] = r.seconds;
+      fits[k] = r.evaluations;
+      // Per found term: its parameterization and the distance of its plane to
+      // the nearest true plane of that parameterization (2 - |P P_true^T|^2, 0 = same plane).
+      nlohmann::json found = nlohmann::json::array();
+      for (const FactorTerm& t : r.factorization->terms()) {
+        double dist = 2;
+        for (const PlantedTerm& pt : b.terms())
+          if (pt.param == t.proj.param) dist = std::min(dist, 2 - (t.proj.P * pt.P.transpose()).squaredNorm());
+        found.push_back({{"parameterization", to_string(t.proj.param)}, {"plane_distance", dist}});
+      }
+      j[names[k]] = {{"rel_mse", err[k]},  {"evaluations", r.evaluations}, {"seconds", r.seconds},
+                     {"terms", found}, {"rel_mse_after_term", r.rel_mse_after_term}};
+    }
+    std::cout << j.dump() << std::endl;
+    std::fprintf(stderr, "| %s | %.4g | %.4g | %.4g | %.4g | %.1fx | %.2fx | %d | %d | %.1f | %.1f |\n",
+                 b.to_string().c_str(), em.back(), err[0], err[1], floor, err[0] / floor, err[1] / floor,
+                 fits[0], fits[1], secs[0], secs[1]);
+  }
 }
 }  // namespace
 
@@ -262,7 +402,43 @@ void add_cmd_bench(CLI::App& app) {
       ->capture_default_str();
   search->add_option("--backfit-restarts", b->backfit_restarts, "random starts per re-search")
       ->capture_default_str();
+  search->add_option("--strategy", b->strategy,
+                     "structured (default), greedy (Cole's, the thesis's) or both (side by side on stderr)")
+      ->check(CLI::IsMember({"structured", "greedy", "both"}))
+      ->capture_default_str();
+  search->add_option("--term-param", b->term_param,
+                     "structured: either (each term picks wiwo or halfdiff) or fixed (--parameterization)")
+      ->check(CLI::IsMember({"either", "fixed"}))
+      ->capture_default_str();
+  search->add_option("--keep", b->keep, "structured: Powell runs per term (best screened starts)")
+      ->capture_default_str();
+  search->add_option("--beam-width", b->beam_width, "structured: configurations kept per step")
+      ->capture_default_str();
+  search->add_option("--polish-sweeps", b->polish_sweeps, "structured: joint re-search sweeps at the end")
+      ->capture_default_str();
   search->callback([b] { run_bench_search(*b); });
+
+  auto* planted = bench->add_subcommand(
+      "planted", "Planted product BRDFs: McCool, greedy and structured search, floor (fit at the true projections)");
+  auto pa = std::make_shared<BenchPlantedArgs>();
+  planted->add_option("--family", pa->family, "rotation (random rotation planes) or mccool (p(wi) q(h) p(wo), 3 terms)")
+      ->check(CLI::IsMember({"rotation", "mccool"}))
+      ->capture_default_str();
+  planted->add_option("--count", pa->count, "members")->capture_default_str();
+  planted->add_option("--first", pa->first, "index of the first member")->capture_default_str();
+  planted->add_option("--terms", pa->terms, "rotation family: 2 or 3 terms")->capture_default_str();
+  planted->add_option("--parameterization", pa->param, "rotation family: wiwo or halfdiff")->capture_default_str();
+  planted->add_option("--grid", pa->grid, "regular res^4 parabolic grid")->capture_default_str();
+  planted->add_option("--texture", pa->texture, "texture resolution (search and floor)")->capture_default_str();
+  planted->add_option("--restarts", pa->restarts, "random starts per term")->capture_default_str();
+  planted->add_option("--solve-last", pa->solve_last, "terms solved jointly (n), search and floor")->capture_default_str();
+  planted->add_option("--beam-width", pa->beam_width, "structured: configurations kept per step")->capture_default_str();
+  planted->add_option("--keep", pa->keep, "structured: Powell runs per step")->capture_default_str();
+  planted->add_option("--threads", pa->threads, "threads (0 = all cores)")->capture_default_str();
+  planted->add_option("--strategy", pa->strategy, "greedy, structured or both")
+      ->check(CLI::IsMember({"structured", "greedy", "both"}))
+      ->capture_default_str();
+  planted->callback([pa] { run_bench_planted(*pa); });
 }
 
 }  // namespace bf

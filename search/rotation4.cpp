@@ -109,12 +109,11 @@ std::array<Rotation4, 6> cole_basis_directions() {
           Rotation4{one, Quat(0, 0, 1, 0)}, Rotation4{one, Quat(0, 0, 0, 1)}};
 }
 
-namespace {
 // (S, T) of a rotation matrix M (orthonormal, det +1). With M v = S v T:
 // M e0 = S T and M e_c = S u_c T for u = (i, j, k), so
 // conj(M e0) (M e_c) = conj(T) u_c T: the columns of the 3D rotation x -> conj(T) x T.
 // Reading that rotation's quaternion gives conj(T), then S = (M e0) conj(T).
-Rotation4 rotation_from_matrix(const Eigen::Matrix4d& M) {
+Rotation4 Rotation4::from_matrix(const Eigen::Matrix4d& M) {
   Eigen::Matrix3d Rt;
   const Quat m0 = M.col(0);
   for (int c = 1; c < 4; ++c) {
@@ -128,7 +127,6 @@ Rotation4 rotation_from_matrix(const Eigen::Matrix4d& M) {
   const Quat S = qmul(m0, qconj(T)).normalized();
   return {S, T};
 }
-}  // namespace
 
 Rotation4 guess_rotation(const std::string& name) {
   if (name == "wi") return Rotation4::identity();
@@ -146,7 +144,7 @@ Rotation4 guess_rotation(const std::string& name) {
     throw std::invalid_argument("guesses: expected \"wi\", \"wo\" or \"wi+wo\", found \"" + name +
                                 "\"");
   }
-  return rotation_from_matrix(M);
+  return Rotation4::from_matrix(M);
 }
 
 }  // namespace bf

@@ -54,6 +54,9 @@ struct Rotation4 {
   Projection projection(Parameterization param, int res) const;
   // [S.w, S.x, S.y, S.z, T.w, T.x, T.y, T.z]
   std::array<double, 8> packed() const;
+  // The rotation of a 4x4 matrix M (orthonormal, det +1; not checked):
+  // matrix() of the result equals M to rounding.
+  static Rotation4 from_matrix(const Eigen::Matrix4d& M);
   static Rotation4 from_packed(const std::array<double, 8>& p) {
     return {Quat(p[0], p[1], p[2], p[3]), Quat(p[4], p[5], p[6], p[7])};
   }

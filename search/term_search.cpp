@@ -3,6 +3,8 @@
 #include "solvers/option_error.h"
 #include "solvers/parallel.h"
 
+#include "search/structured_search.h"
+
 #include <nlopt.hpp>
 
 #include <algorithm>
@@ -26,6 +28,28 @@ double now_seconds() {
 }  // namespace
 
 void SearchOptions::validate() const {
+  if (strategy != "structured" && strategy != "greedy")
+    throw OptionError("strategy", "strategy: expected \"structured\" or \"greedy\", found \"" + strategy + "\"");
+  if (term_param != "either" && term_param != "fixed")
+    throw OptionError("term_param", "term_param: expected \"either\" or \"fixed\", found \"" + term_param + "\"");
+  if (keep < 1) throw OptionError("keep", "keep: expected >= 1, found " + std::to_string(keep));
+  if (beam_width < 1) throw OptionError("beam_width", "beam_width: expected >= 1, found " + std::to_string(beam_width));
+  if (joint_polish_terms < 0)
+    throw OptionError("joint_polish_terms", "joint_polish_terms: expected >= 0, found " + std::to_string(joint_polish_terms));
+  if (polish_sweeps < 0)
+    throw OptionError("polish_sweeps", "polish_sweeps: expected >= 0, found " + std::to_string(polish_sweeps));
+  if (strategy == "structured") {
+    if (beam != 1)
+      throw OptionError("beam", "beam: the structured strategy has no beam (expected 1, found " +
+                                  std::to_string(beam) + "); beam is an option of strategy = \"greedy\"");
+    if (backfit_sweeps != 0)
+      throw OptionError("backfit_sweeps", "backfit_sweeps: the structured strategy polishes with polish_sweeps "
+                                  "(expected 0, found " + std::to_string(backfit_sweeps) +
+                                  "); backfitting is an option of strategy = \"greedy\"");
+    if (optimizer != "powell")
+      throw OptionError("optimizer", "optimizer: the structured strategy uses powell, found \"" + optimizer +
+                                  "\"; the nlopt optimizers are options of strategy = \"greedy\"");
+  }
   if (terms < 1) throw OptionError("terms", "terms: expected >= 1, found " + std::to_string(terms));
   if (texture_size < 2 || texture_size > 1024)
     throw OptionError("texture_size", "texture_size: expected 2..1024, found " +
@@ -36,7 +60,7 @@ void SearchOptions::validate() const {
   if (restarts < 0)
     throw OptionError("restarts", "restarts: expected >= 0, found " + std::to_string(restarts));
   for (const auto& g : guesses) guess_rotation(g);  // throws for unknown names
-  if (restarts == 0 && guesses.empty())
+  if (strategy == "greedy" && restarts == 0 && guesses.empty())
     throw OptionError("restarts", "restarts: 0 restarts and no guesses leave nothing to search from");
   if (std::find(std::begin(kOptimizers), std::end(kOptimizers), optimizer) == std::end(kOptimizers))
     throw OptionError("optimizer", "optimizer: expected powell, praxis, bobyqa, neldermead, sbplx, "
@@ -44,7 +68,7 @@ void SearchOptions::validate() const {
   if (threads < 0)
     throw OptionError("threads", "threads: expected >= 0, found " + std::to_string(threads));
   const int starts = restarts + static_cast<int>(guesses.size());
-  if (beam < 1 || beam > starts)
+  if (strategy == "greedy" && (beam < 1 || beam > starts))
     throw OptionError("beam", "beam: expected 1..(restarts + guesses) = 1.." +
                                 std::to_string(starts) + ", found " + std::to_string(beam));
   if (backfit_sweeps < 0)
@@ -365,6 +389,7 @@ double ScheduleObjective::operator()(const Rotation4& r) const {
 
 SearchResult search_factorization(const FitData& data, const SearchOptions& opt) {
   opt.validate();
+  if (opt.strategy == "structured") return structured_search(data, opt);
   const double t0 = now_seconds();
   const int sres = opt.search_texture_size > 0 ? opt.search_texture_size : opt.texture_size;
   SearchResult out;

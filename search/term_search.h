@@ -30,8 +30,25 @@
 namespace bf {
 
 struct SearchOptions {
+  // "structured" (structured_search.h: seeds read off the data's Hessians,
+  // screened starts, pair moves, joint polish, per-term parameterization) or
+  // "greedy" (Cole's search of this file, the thesis's; reproduces the numbers
+  // of earlier versions). beam, backfitting and the nlopt optimizers are
+  // options of the greedy strategy only.
+  std::string strategy = "structured";
   int terms = 2;                        // textures to build, >= 1
+  // The parameterization of every term (greedy; structured with term_param = "fixed").
   Parameterization param = Parameterization::WiWo;
+  // Structured only: "either" = each term reads the wiwo or the halfdiff point,
+  // chosen by the search; "fixed" = every term reads `param`.
+  std::string term_param = "either";
+  int keep = 3;                         // structured: Powell runs per term (best screened starts), >= 1
+  int polish_sweeps = 2;                // structured: joint re-search sweeps at the end, >= 0
+  int beam_width = 8;                   // structured: partial configurations kept per step, >= 1
+  bool final_joint = true;              // structured: the final refit solves all terms jointly
+  // Structured, with final_joint: searches of up to this many terms also
+  // polish under the joint objective (larger ones polish the schedule's), >= 0.
+  int joint_polish_terms = 3;
   int texture_size = 16;                // final texture resolution
   int search_texture_size = 0;          // resolution during the search; 0 = texture_size
   int restarts = 6;                     // seeded random starts per term, >= 0

@@ -52,7 +52,21 @@ const std::vector<KeySpec>& search_keys() {
                 "extra seeded random starts per re-search (besides the current rotation)"),
         other_key("tolerance", "table", "",
                   "stop after the first term that reaches the target; `terms` is then the cap (default 8); "
-                  "needs `beam = 1`")};
+                  "needs `beam = 1`"),
+        choice_key("strategy", {"greedy", "structured"}, "greedy",
+                   "`greedy`: Cole's search, term by term (the keys above). `structured` (search/structured_search.h): "
+                   "starts from planes read off the data's Hessians, Cole's guesses in both parameterizations and "
+                   "seeded random rotations, a beam of partial configurations, a joint polish of every term and a "
+                   "joint final refit; refuses `beam`, `backfit_*` and the nlopt optimizers. Measured in docs/search.md"),
+        choice_key("term_param", {"either", "fixed"}, "either",
+                   "structured: each term reads the wiwo or the halfdiff point as the search chooses (`either`), or "
+                   "every term reads `parameterization` (`fixed`)"),
+        int_key("keep", 1, 1000, "3", "structured: starts refined by Powell per term (the best by one fit each)"),
+        int_key("polish_sweeps", 0, 1000, "2", "structured: final sweeps re-searching each term with the others held"),
+        int_key("beam_width", 1, 1000, "8", "structured: partial configurations kept per term"),
+        bool_key("final_joint", "true", "structured: the final refit solves all terms jointly"),
+        int_key("joint_polish_terms", 0, 64, "3",
+                "structured: searches of up to this many terms pick their last term and polish under the joint fit")};
     k.insert(k.end(), own.begin(), own.end());
     return k;
   }();
@@ -102,6 +116,15 @@ void record_options(const MethodVariant& m, json& o) {
   o["max_evaluations"] = s.powell.max_evaluations;
   o["seed"] = m.seed;
   // Non-greedy options enter the run id only when set, so greedy runs keep their cache.
+  if (s.strategy != "greedy") {
+    o["strategy"] = s.strategy;
+    o["term_param"] = s.term_param;
+    o["keep"] = s.keep;
+    o["polish_sweeps"] = s.polish_sweeps;
+    o["beam_width"] = s.beam_width;
+    o["final_joint"] = s.final_joint;
+    o["joint_polish_terms"] = s.joint_polish_terms;
+  }
   if (s.beam != 1) o["beam"] = s.beam;
   if (s.backfit_sweeps != 0) o["backfit_sweeps"] = s.backfit_sweeps;
   if (s.backfit_sweeps != 0 && s.backfit_restarts != 0) o["backfit_restarts"] = s.backfit_restarts;
@@ -143,6 +166,15 @@ class SearchKind final : public HomomorphicKind {
   void read(Reader& r, MethodVariant& m, json& o, uint64_t base_seed) const override {
     read_refine_options(r, m, o);
     SearchOptions& s = m.search;
+    // Configs default to Cole's greedy search (existing configs keep their
+    // results and run ids); strategy = "structured" selects the new search.
+    s.strategy = r.choice(key("strategy"), "greedy");
+    s.term_param = r.choice(key("term_param"), s.term_param);
+    s.keep = static_cast<int>(r.integer(key("keep"), s.keep));
+    s.polish_sweeps = static_cast<int>(r.integer(key("polish_sweeps"), s.polish_sweeps));
+    s.beam_width = static_cast<int>(r.integer(key("beam_width"), s.beam_width));
+    s.final_joint = r.boolean(key("final_joint"), s.final_joint);
+    s.joint_polish_terms = static_cast<int>(r.integer(key("joint_polish_terms"), s.joint_polish_terms));
     m.param = read_param(r, "parameterization", s.param);
     m.tolerance = read_tolerance(r, o);
     // With a tolerance, `terms` is the cap (default 8): the greedy search stops
@@ -167,7 +199,7 @@ class SearchKind final : public HomomorphicKind {
     s.backfit_restarts = static_cast<int>(r.integer(key("backfit_restarts"), s.backfit_restarts));
     m.seed = static_cast<uint64_t>(r.integer(key("seed"), static_cast<int64_t>(base_seed)));
     read_fit_options(r, m.fit, o);
-    if (s.restarts == 0 && s.guesses.empty() && !r.failed())
+    if (s.strategy == "greedy" && s.restarts == 0 && s.guesses.empty() && !r.failed())
       r.fail("restarts", "restarts = 0 and no guesses leave nothing to search from (give restarts >= 1 or guesses)");
     s.terms = m.terms;
     s.param = m.param;

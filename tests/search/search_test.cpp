@@ -1,5 +1,6 @@
 // Tests of the Powell search and the greedy term builder.
 #include <random>
+#include <string>
 
 #include "brdfs/sampleset.h"
 #include "factor/fit_helpers.h"
@@ -36,6 +37,7 @@ const SampleSet& planted_grid8() {
 }
 SearchOptions small_search(int terms, int restarts) {
   SearchOptions opt;
+  opt.strategy = "greedy";
   opt.terms = terms;
   opt.texture_size = 6;
   opt.restarts = restarts;
@@ -66,7 +68,9 @@ TEST_CASE("search: recovers a planted single-term projection") {
   const Rotation4 truth = Rotation4::random(rng);
   const OneTermBrdf brdf(truth);
   const SampleSet s = sample_grid(brdf, 10);
+  const std::string strategy = GENERATE("greedy", "structured");
   SearchOptions opt;
+  opt.strategy = strategy;
   opt.terms = 1;
   opt.texture_size = 8;
   opt.restarts = 4;
@@ -78,7 +82,7 @@ TEST_CASE("search: recovers a planted single-term projection") {
                                   opt.fit);
   const double e_id = evaluate_metrics(*id, s, d.transform).rel_mse;
   const double e = evaluate_metrics(*res.factorization, s, d.transform).rel_mse;
-  INFO("searched " << e << " vs identity " << e_id << ", " << res.evaluations << " evaluations");
+  INFO(strategy << ": searched " << e << " vs identity " << e_id << ", " << res.evaluations << " evaluations");
   CHECK(e < 1e-3);
   CHECK(e < 0.05 * e_id);
   REQUIRE(res.terms.size() == 1);
@@ -106,6 +110,7 @@ TEST_CASE("search: nlopt optimizers share the objective and improve on their sta
   const FitData d(s, 1e-5);
   for (const char* name : {"praxis", "bobyqa", "neldermead", "sbplx", "direct", "crs"}) {
     SearchOptions opt;
+    opt.strategy = "greedy";
     opt.terms = 1;
     opt.texture_size = 6;
     opt.restarts = 0;
@@ -130,8 +135,24 @@ TEST_CASE("search: options are validated with the field named") {
   opt.optimizer = "simplex";
   CHECK_THROWS_WITH(opt.validate(), Catch::Contains("optimizer") && Catch::Contains("simplex"));
   opt = SearchOptions{};
+  opt.strategy = "greedy";
   opt.restarts = 0;
   CHECK_THROWS_WITH(opt.validate(), Catch::Contains("nothing to search from"));
+  opt.strategy = "structured";  // the structured search has its seeds and guesses
+  CHECK_NOTHROW(opt.validate());
+  opt = SearchOptions{};
+  opt.strategy = "annealing";
+  CHECK_THROWS_WITH(opt.validate(), Catch::Contains("strategy") && Catch::Contains("annealing"));
+  opt = SearchOptions{};
+  opt.term_param = "both";
+  CHECK_THROWS_WITH(opt.validate(), Catch::Contains("term_param") && Catch::Contains("both"));
+  opt = SearchOptions{};
+  opt.beam = 2;
+  opt.restarts = 3;
+  CHECK_THROWS_WITH(opt.validate(), Catch::Contains("beam") && Catch::Contains("greedy"));
+  opt.beam = 1;
+  opt.optimizer = "praxis";
+  CHECK_THROWS_WITH(opt.validate(), Catch::Contains("optimizer") && Catch::Contains("greedy"));
   opt = SearchOptions{};
   opt.guesses = {"h"};
   CHECK_THROWS_WITH(opt.validate(), Catch::Contains("guesses"));
@@ -208,6 +229,7 @@ TEST_CASE("search: the backfitting objective with one term changed equals a fres
     CHECK(std::abs(v - errs.back()) <= 1e-6 * errs.back());
   }
   SearchOptions bad = opt;
+  bad.strategy = "greedy";
   bad.beam = 5;
   bad.restarts = 2;
   CHECK_THROWS_WITH(bad.validate(), Catch::Contains("beam") && Catch::Contains("1..2") &&

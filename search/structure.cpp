@@ -1,0 +1,183 @@
+// Hessian structure of scattered data (see structure.h).
+#include "search/structure.h"
+
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <stdexcept>
+#include <limits>
+#include <unordered_map>
+
+#include "search/powell.h"
+
+namespace bf {
+
+std::vector<Eigen::Matrix4d> local_hessians(const std::vector<Vec4>& x, const std::vector<double>& y,
+                                            const std::vector<double>& w, const StructureOptions& opt) {
+  const size_t N = x.size();
+  if (y.size() != N || (!w.empty() && w.size() != N))
+    throw std::invalid_argument("local_hessians: x, y and w must have one entry per sample");
+  if (opt.centres < 1 || !(opt.radius > 0) || opt.min_neighbours < 15)
+    throw std::invalid_argument("local_hessians: expected centres >= 1, radius > 0, min_neighbours >= 15");
+  std::vector<Eigen::Matrix4d> out;
+  if (N == 0) return out;
+  // Buckets of side `radius`: a ball of that radius meets at most 3^4 of them.
+  Vec4 lo = x[0];
+  for (const Vec4& p : x) lo = lo.cwiseMin(p);
+  const double r = opt.radius, r2 = r * r;
+  auto cell_of = [&](const Vec4& p) {
+    std::array<int, 4> c;
+    for (int i = 0; i < 4; ++i) c[i] = static_cast<int>(std::floor((p[i] - lo[i]) / r));
+    return c;
+  };
+  auto key = [](const std::array<int, 4>& c) {
+    return (((static_cast<int64_t>(c[0]) * 1024 + c[1]) * 1024 + c[2]) * 1024) + c[3];
+  };
+  std::unordered_map<int64_t, std::vector<uint32_t>> buckets;
+  for (size_t k = 0; k < N; ++k) buckets[key(cell_of(x[k]))].push_back(static_cast<uint32_t>(k));
+
+  std::vector<size_t> centres(N);
+  for (size_t k = 0; k < N; ++k) centres[k] = k;
+  if (N > static_cast<size_t>(opt.centres)) {
+    std::mt19937_64 rng(opt.seed);
+    for (int i = 0; i < opt.centres; ++i) {
+      std::uniform_int_distribution<size_t> u(i, N - 1);
+      std::swap(centres[i], centres[u(rng)]);
+    }
+    centres.resize(opt.centres);
+  }
+  // Features about the centre c, z = x - c: 1, z_i, z_i z_j (i <= j): 15.
+  using Vec15 = Eigen::Matrix<double, 15, 1>;
+  using Mat15 = Eigen::Matrix<double, 15, 15>;
+  for (size_t ci : centres) {
+    const Vec4& c = x[ci];
+    const auto cc = cell_of(c);
+    Mat15 A = Mat15::Zero();
+    Vec15 b = Vec15::Zero();
+    int count = 0;
+    for (int d0 = -1; d0 <= 1; ++d0)
+      for (int d1 = -1; d1 <= 1; ++d1)
+        for (int d2 = -1; d2 <= 1; ++d2)
+          for (int d3 = -1; d3 <= 1; ++d3) {
+            const auto it = buckets.find(key({cc[0] + d0, cc[1] + d1, cc[2] + d2, cc[3] + d3}));
+            if (it == buckets.end()) continue;
+            for (uint32_t k : it->second) {
+              const Vec4 z = x[k] - c;
+              const double d2z = z.squaredNorm();
+              if (d2z >= r2) continue;
+              const double t = 1 - d2z / r2;
+              const double wk = t * t * (w.empty() ? 1.0 : w[k]);
+              if (!(wk > 0)) continue;
+              Vec15 f;
+              f[0] = 1;
+              for (int i = 0; i < 4; ++i) f[1 + i] = z[i] / r;
+              int m = 5;
+              for (int i = 0; i < 4; ++i)
+                for (int j = i; j < 4; ++j) f[m++] = z[i] * z[j] / r2;
+              A.selfadjointView<Eigen::Lower>().rankUpdate(f, wk);
+              b += wk * y[k] * f;
+              ++count;
+            }
+          }
+    if (count < opt.min_neighbours) continue;
+    A.triangularView<Eigen::StrictlyUpper>() = A.transpose();
+    A.diagonal() *= 1 + 1e-10;
+    const Eigen::LDLT<Mat15> ldlt(A);
+    if (ldlt.info() != Eigen::Success) continue;
+    const Vec15 coef = ldlt.solve(b);
+    if (!coef.allFinite()) continue;
+    Eigen::Matrix4d H;
+    int m = 5;
+    for (int i = 0; i < 4; ++i)
+      for (int j = i; j < 4; ++j) {
+        const double v = coef[m++] / r2;
+        if (i == j) H(i, i) = 2 * v;
+        else H(i, j) = H(j, i) = v;
+      }
+    out.push_back(H);
+  }
+  return out;
+}
+
+namespace {
+// Off-block and plane-A energies of the Hessians in the frame Q (columns 0, 1 = plane A).
+void block_energies(const std::vector<Eigen::Matrix4d>& hs, const Eigen::Matrix4d& Q, double* off,
+                    double* a) {
+  double o = 0, s = 0;
+  for (const Eigen::Matrix4d& H : hs) {
+    const Eigen::Matrix4d G = Q.transpose() * H * Q;
+    o += 2 * G.block<2, 2>(0, 2).squaredNorm();
+    s += G.block<2, 2>(0, 0).squaredNorm();
+  }
+  *off = o;
+  *a = s;
+}
+}  // namespace
+
+PlaneSplit split_planes(const std::vector<Eigen::Matrix4d>& hessians) {
+  if (hessians.empty()) throw std::invalid_argument("split_planes: no Hessians (too few samples?)");
+  // Powell runs on a subset (the objective is a sum; 200 terms pin it well).
+  std::vector<Eigen::Matrix4d> hs;
+  const size_t stride = std::max<size_t>(1, hessians.size() / 200);
+  for (size_t k = 0; k < hessians.size(); k += stride) hs.push_back(hessians[k]);
+  double total = 0;
+  Eigen::Matrix4d M = Eigen::Matrix4d::Zero();
+  for (const Eigen::Matrix4d& H : hs) {
+    total += H.squaredNorm();
+    M += H * H;
+  }
+  if (!(total > 0)) total = 1;
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix4d> es(M);
+  const Eigen::Matrix4d V = es.eigenvectors();
+  const int pairings[3][4] = {{3, 2, 1, 0}, {3, 1, 2, 0}, {3, 0, 2, 1}};
+  const auto objective = [&](const Rotation4& R) {
+    double o, a;
+    block_energies(hs, R.normalized().matrix(), &o, &a);
+    return o / total;
+  };
+  // The three pairings of the eigenvectors; Powell polishes the best one
+  // (near-degenerate eigenvalues mix the planes' eigenvectors, which Powell undoes).
+  PowellOptions po;
+  po.ftol = 1e-6;
+  po.line_tol = 1e-3;
+  po.max_evaluations = 1500;
+  PlaneSplit best;
+  double best_start = std::numeric_limits<double>::infinity();
+  for (const auto& p : pairings) {
+    Eigen::Matrix4d Q;
+    for (int c = 0; c < 4; ++c) Q.col(c) = V.col(p[c]);
+    if (Q.determinant() < 0) Q.col(3) = -Q.col(3);
+    const Rotation4 R = Rotation4::from_matrix(Q);
+    const double v = objective(R);
+    if (v < best_start) {
+      best_start = v;
+      best.first = R;
+    }
+  }
+  best.first = powell_minimize(objective, best.first, po).best.normalized();
+  Eigen::Matrix4d Q = best.first.matrix();
+  double off, a;
+  block_energies(hessians, Q, &off, &a);
+  double all = 0;
+  for (const Eigen::Matrix4d& H : hessians) all += H.squaredNorm();
+  if (!(all > 0)) all = 1;
+  // Plane A carries the larger diagonal block.
+  double b = all - off - a;
+  if (b > a) {
+    Eigen::Matrix4d S;
+    S << Q.col(2), Q.col(3), Q.col(0), Q.col(1);
+    Q = S;
+    std::swap(a, b);
+  }
+  best.first = Rotation4::from_matrix(Q);
+  Eigen::Matrix4d S;
+  S << Q.col(2), Q.col(3), Q.col(0), Q.col(1);  // (0 2)(1 3): det +1
+  best.second = Rotation4::from_matrix(S);
+  best.off_block = off / all;
+  best.share_a = a / all;
+  return best;
+}
+
+}  // namespace bf

@@ -1,0 +1,416 @@
+// The structured projection search (see structured_search.h).
+#include "search/structured_search.h"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <thread>
+
+#include "search/structure.h"
+
+namespace bf {
+
+namespace {
+
+double now_seconds() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+struct Term {
+  Rotation4 R;
+  Parameterization p = Parameterization::WiWo;
+};
+
+struct Start {
+  Term t;
+  double value = kInf;  // objective at the start (screening)
+  int index = 0;        // position in the start list (TermRecord::best_start)
+};
+
+int pidx(Parameterization p) { return p == Parameterization::WiWo ? 0 : 1; }
+
+// 2 - |P_a P_b^T|_F^2: 0 for the same plane, 2 for orthogonal planes.
+double plane_distance(const Rotation4& a, const Rotation4& b) {
+  const Eigen::Matrix4d A = a.matrix(), B = b.matrix();
+  return 2 - (A.leftCols<2>().transpose() * B.leftCols<2>()).squaredNorm();
+}
+
+size_t first_joint(size_t step, int n) {
+  return step + 1 > static_cast<size_t>(n) ? step + 1 - n : 0;
+}
+
+// Runs fn(i) for i in [0, n) on the option's threads; results by index, so
+// independent of scheduling.
+template <class Fn>
+void parallel_for(size_t n, int threads, Fn fn) {
+  const unsigned hw = std::max(1u, std::thread::hardware_concurrency());
+  const unsigned nthreads = std::min<unsigned>(threads > 0 ? threads : hw, n);
+  std::atomic<size_t> next{0};
+  auto worker = [&] {
+    for (size_t i = next++; i < n; i = next++) fn(i);
+  };
+  std::vector<std::thread> pool;
+  for (unsigned t = 1; t < nthreads; ++t) pool.emplace_back(worker);
+  worker();
+  for (auto& th : pool) th.join();
+}
+
+class Structured {
+ public:
+  Structured(const FitData& d, const SearchOptions& opt)
+      : d_(d), opt_(opt), sres_(opt.search_texture_size > 0 ? opt.search_texture_size : opt.texture_size) {
+    popt_[0] = opt;
+    popt_[0].param = Parameterization::WiWo;
+    popt_[1] = opt;
+    popt_[1].param = Parameterization::HalfDiff;
+    if (opt.term_param == "fixed") params_ = {opt.param};
+    else params_ = {Parameterization::WiWo, Parameterization::HalfDiff};
+  }
+
+  SearchResult run();
+
+ private:
+  TermSpec spec(const Term& t, int res) const {
+    return TermSpec{t.R.projection(t.p, res), opt_.reciprocity, t.R.packed()};
+  }
+  std::vector<TermSpec> specs(const std::vector<Term>& ts, int res) const {
+    std::vector<TermSpec> out;
+    for (const Term& t : ts) out.push_back(spec(t, res));
+    return out;
+  }
+  // The fit schedule at the search resolution: its error, and the texels.
+  // n: terms solved jointly (0 = the option's solve_last).
+  double schedule(const std::vector<Term>& ts, std::vector<FactorTerm>* done, int n = 0) const;
+  // Mean over channels of g minus the given terms' values (the residual log BRDF).
+  std::vector<double> residual(const std::vector<FactorTerm>& done) const;
+  // Seed plane pairs of a residual, one per allowed parameterization.
+  std::vector<std::pair<Parameterization, PlaneSplit>> seeds(const std::vector<double>& y) const;
+  struct Config {
+    std::vector<Term> ts;
+    std::vector<FactorTerm> done;  // the schedule's texels at the search resolution
+    double value = kInf;
+    int start = 0;                 // index of the start of the last term
+  };
+  // One beam step: the configs after adding term j to each of `beam`.
+  // n: terms solved jointly in this step's objective.
+  std::vector<Config> step(const std::vector<Config>& beam, int j, int n, TermRecord* rec);
+  // Jacobi sweeps over terms [from, J): each re-searched with the others held.
+  // The objective is the schedule with n terms solved jointly.
+  void polish(std::vector<Term>& ts, double& value, size_t from, int sweeps, int n, TermRecord* rec);
+
+  const FitData& d_;
+  const SearchOptions& opt_;
+  int sres_;
+  SearchOptions popt_[2];
+  std::vector<Parameterization> params_;
+  int evaluations_ = 0;
+};
+
+double Structured::schedule(const std::vector<Term>& ts, std::vector<FactorTerm>* done_out, int n) const {
+  FitOptions fo = opt_.fit;
+  if (n > 0) fo.solve_last = n;
+  n = fo.solve_last;
+  const std::vector<TermSpec> sp = specs(ts, sres_);
+  std::vector<FactorTerm> done;
+  double value = kInf;
+  for (size_t s = 0; s < sp.size(); ++s) {
+    const size_t first = first_joint(s, n);
+    std::vector<FactorTerm> fixed(done.begin(), done.begin() + first);
+    std::vector<TermSpec> joint(sp.begin() + first, sp.begin() + s + 1);
+    try {
+      const JointSolution sol = solve_joint(d_, fixed_sum(d_, fixed), joint, fo, false);
+      done = fixed;
+      done.insert(done.end(), sol.terms.begin(), sol.terms.end());
+      value = sol.rel_mse;
+    } catch (const std::runtime_error&) {
+      if (done_out) done_out->clear();
+      return kInf;
+    }
+  }
+  if (done_out) *done_out = std::move(done);
+  return value;
+}
+
+std::vector<double> Structured::residual(const std::vector<FactorTerm>& done) const {
+  const auto f = fixed_sum(d_, done);
+  std::vector<double> y(d_.size());
+  for (size_t k = 0; k < y.size(); ++k)
+    y[k] = ((d_.g[0][k] - f[0][k]) + (d_.g[1][k] - f[1][k]) + (d_.g[2][k] - f[2][k])) / 3;
+  return y;
+}
+
+std::vector<std::pair<Parameterization, PlaneSplit>> Structured::seeds(const std::vector<double>& y) const {
+  std::vector<std::pair<Parameterization, PlaneSplit>> out;
+  StructureOptions so;
+  so.seed = opt_.seed;
+  for (Parameterization p : params_) {
+    const std::vector<Eigen::Matrix4d> hs = local_hessians(d_.points(p), y, d_.w, so);
+    if (hs.empty()) continue;
+    out.emplace_back(p, split_planes(hs));
+  }
+  return out;
+}
+
+// One step of the beam: every config extended by every screened start; Powell
+// from the `keep` best distinct (config, start) pairs; the new beam is the best
+// refined configs plus the best unrefined seed configs (see the header).
+std::vector<Structured::Config> Structured::step(const std::vector<Config>& beam, int j, int n, TermRecord* rec) {
+  const double t0 = now_seconds();
+  struct Cand {
+    size_t b;      // beam config extended
+    Start s;       // the start (term, value at the start)
+    bool seed;     // read off the residual's Hessians, or a guess (not a random start)
+  };
+  std::vector<Cand> cands;
+  // Objectives per (config, parameterization); built once, shared by threads.
+  std::vector<std::array<std::unique_ptr<TermObjective>, 2>> obj(beam.size());
+  // The configs' seed planes, in parallel (independent; results by index).
+  std::vector<std::vector<std::pair<Parameterization, PlaneSplit>>> seed_of(beam.size());
+  parallel_for(beam.size(), opt_.threads, [&](size_t b) { seed_of[b] = seeds(residual(beam[b].done)); });
+  for (size_t b = 0; b < beam.size(); ++b) {
+    const Config& c = beam[b];
+    const size_t first = first_joint(j, n);
+    const std::vector<FactorTerm> fixed(c.done.begin(), c.done.begin() + first);
+    std::vector<TermSpec> known;
+    for (size_t i = first; i < static_cast<size_t>(j); ++i) known.push_back(spec(c.ts[i], sres_));
+    for (Parameterization p : params_)
+      obj[b][pidx(p)] = std::make_unique<TermObjective>(d_, fixed, known, popt_[pidx(p)], sres_);
+    int index = 0;
+    auto add = [&](const Rotation4& R, Parameterization p, bool seed) {
+      cands.push_back(Cand{b, Start{Term{R, p}, kInf, index++}, seed});
+    };
+    for (const auto& [p, sp] : seed_of[b]) {
+      add(sp.first, p, true);
+      add(sp.second, p, true);
+    }
+    std::vector<std::string> guesses = {"wi", "wo"};
+    for (const std::string& g : opt_.guesses)
+      if (std::find(guesses.begin(), guesses.end(), g) == guesses.end()) guesses.push_back(g);
+    for (Parameterization p : params_)
+      for (const std::string& g : guesses) add(guess_rotation(g), p, true);
+    for (int r = 0; r < opt_.restarts; ++r) {
+      std::mt19937_64 rng(opt_.seed * 1000003ull + j * 7919ull + r);
+      add(Rotation4::random(rng), params_[r % params_.size()], false);
+    }
+  }
+  parallel_for(cands.size(), opt_.threads, [&](size_t i) {
+    Cand& c = cands[i];
+    c.s.value = (*obj[c.b][pidx(c.s.t.p)])(c.s.t.R);
+  });
+  evaluations_ += static_cast<int>(cands.size());
+  rec->evaluations += static_cast<int>(cands.size());
+
+  std::vector<size_t> order(cands.size());
+  for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(),
+                   [&](size_t a, size_t b) { return cands[a].s.value < cands[b].s.value; });
+  const auto distinct = [&](const std::vector<size_t>& chosen, size_t i) {
+    for (size_t k : chosen)
+      if (cands[k].b == cands[i].b && cands[k].s.t.p == cands[i].s.t.p &&
+          plane_distance(cands[k].s.t.R, cands[i].s.t.R) < 0.02)
+        return false;
+    return std::isfinite(cands[i].s.value);
+  };
+  std::vector<size_t> refine;
+  for (size_t i : order)
+    if (static_cast<int>(refine.size()) < opt_.keep && distinct(refine, i)) refine.push_back(i);
+  std::vector<PowellResult> res(refine.size());
+  parallel_for(refine.size(), opt_.threads, [&](size_t k) {
+    const Cand& c = cands[refine[k]];
+    res[k] = powell_minimize(std::cref(*obj[c.b][pidx(c.s.t.p)]), c.s.t.R, opt_.powell);
+  });
+  for (const PowellResult& r : res) {
+    evaluations_ += r.evaluations;
+    rec->evaluations += r.evaluations;
+  }
+  // New beam: refined configs first (best ceil(B/2)), then unrefined seed
+  // configs (the planes read off the data, kept even when a single term
+  // refined elsewhere fits better: the trap of the greedy search), then
+  // anything else, by value.
+  struct Next {
+    size_t b;
+    Term t;
+    double value;
+    int start;
+  };
+  std::vector<Next> refined, seeds_next, others;
+  for (size_t k = 0; k < refine.size(); ++k)
+    refined.push_back({cands[refine[k]].b, Term{res[k].best.normalized(), cands[refine[k]].s.t.p}, res[k].value,
+                       cands[refine[k]].s.index});
+  std::stable_sort(refined.begin(), refined.end(), [](const Next& a, const Next& b) { return a.value < b.value; });
+  std::vector<size_t> taken_seeds;
+  for (size_t i : order) {
+    if (!distinct(taken_seeds, i)) continue;
+    taken_seeds.push_back(i);
+    (cands[i].seed ? seeds_next : others).push_back({cands[i].b, cands[i].s.t, cands[i].s.value, cands[i].s.index});
+  }
+  const size_t B = static_cast<size_t>(opt_.beam_width);
+  std::vector<Next> chosen;
+  // A configuration already chosen (same parameterizations, same planes in
+  // order, whatever start or parent it came from) is not taken twice.
+  const auto same = [&](const Next& x, const Next& y) {
+    const std::vector<Term>&tx = beam[x.b].ts, &ty = beam[y.b].ts;
+    if (x.t.p != y.t.p || plane_distance(x.t.R, y.t.R) >= 0.02) return false;
+    for (size_t i = 0; i < tx.size(); ++i)
+      if (tx[i].p != ty[i].p || plane_distance(tx[i].R, ty[i].R) >= 0.02) return false;
+    return true;
+  };
+  const auto take = [&](const Next& x, size_t limit) {
+    if (chosen.size() >= limit) return;
+    for (const Next& c : chosen)
+      if (same(c, x)) return;
+    chosen.push_back(x);
+  };
+  for (const Next& x : refined) take(x, (B + 1) / 2);
+  // Every parent configuration (best first) keeps its best seed or guess
+  // extension, so a good partial configuration is not crowded out by the
+  // extensions of another one.
+  for (size_t b = 0; b < beam.size(); ++b)
+    for (const Next& x : seeds_next)
+      if (x.b == b) {
+        take(x, B);
+        break;
+      }
+  for (const Next& x : seeds_next) take(x, B);
+  for (const Next& x : refined) take(x, B);
+  for (const Next& x : others) take(x, B);
+  std::vector<Config> out;
+  for (const Next& x : chosen) {
+    Config c;
+    c.ts = beam[x.b].ts;
+    c.ts.push_back(x.t);
+    c.value = schedule(c.ts, &c.done, n);
+    c.start = x.start;
+    ++evaluations_;
+    ++rec->evaluations;
+    if (std::isfinite(c.value)) out.push_back(std::move(c));
+  }
+  std::stable_sort(out.begin(), out.end(), [](const Config& a, const Config& b) { return a.value < b.value; });
+  rec->seconds += now_seconds() - t0;
+  return out;
+}
+
+void Structured::polish(std::vector<Term>& ts, double& value, size_t from, int sweeps, int n, TermRecord* rec) {
+  const double t0 = now_seconds();
+  const size_t J = ts.size();
+  SearchOptions po[2] = {popt_[0], popt_[1]};
+  po[0].fit.solve_last = po[1].fit.solve_last = n;
+  for (int sweep = 0; sweep < sweeps; ++sweep) {
+    // Each term re-searched from its rotation with the others held (in parallel).
+    const std::vector<TermSpec> sp = specs(ts, sres_);
+    std::vector<PowellResult> res(J);
+    parallel_for(J - from, opt_.threads, [&](size_t k) {
+      const size_t i = from + k;
+      if (static_cast<size_t>(n) >= J) {
+        // All terms joint: the objective is one solve with term i last, so the
+        // other terms' part of the normal matrix is built once (TermObjective).
+        std::vector<TermSpec> others;
+        for (size_t k2 = 0; k2 < J; ++k2)
+          if (k2 != i) others.push_back(sp[k2]);
+        const TermObjective objective(d_, {}, others, po[pidx(ts[i].p)], sres_);
+        res[i] = powell_minimize(std::cref(objective), ts[i].R, opt_.powell);
+      } else {
+        const ScheduleObjective objective(d_, sp, i, po[pidx(ts[i].p)], sres_);
+        res[i] = powell_minimize(std::cref(objective), ts[i].R, opt_.powell);
+      }
+    });
+    std::vector<size_t> order;
+    for (size_t i = from; i < J; ++i) {
+      evaluations_ += res[i].evaluations;
+      rec->backfit_evaluations += res[i].evaluations;
+      if (res[i].value < value * (1 - 1e-9)) order.push_back(i);
+    }
+    std::stable_sort(order.begin(), order.end(),
+                     [&](size_t a, size_t b) { return res[a].value < res[b].value; });
+    bool moved = false;
+    for (size_t i : order) {  // best move first; each checked on the current schedule
+      std::vector<Term> trial = ts;
+      trial[i].R = res[i].best.normalized();
+      const double v = schedule(trial, nullptr, n);
+      ++evaluations_;
+      ++rec->backfit_evaluations;
+      if (v < value * (1 - 1e-9)) {
+        ts = std::move(trial);
+        value = v;
+        moved = true;
+        ++rec->backfit_moves;
+      }
+    }
+    if (!moved) break;
+  }
+  rec->seconds += now_seconds() - t0;
+}
+
+SearchResult Structured::run() {
+  const double t0 = now_seconds();
+  SearchResult out;
+  std::vector<Config> beam(1);
+  beam[0].value = kInf;
+  std::vector<TermRecord> records;
+  std::shared_ptr<HomomorphicFactorization> f;
+  std::vector<double> errors;
+  const auto refit = [&](const std::vector<Term>& ts) {
+    errors.clear();
+    FitOptions fo = opt_.fit;
+    // The joint refit: every term solved together (the schedule's solution is
+    // one point of that problem, so its least-squares error is never higher).
+    if (opt_.final_joint) fo.solve_last = std::max(fo.solve_last, static_cast<int>(ts.size()));
+    f = fit_homomorphic(d_, specs(ts, opt_.texture_size), fo, "search", &errors);
+  };
+  // Small searches are polished and refitted under the joint objective (all
+  // terms solved together); their last term is searched under it too (the
+  // schedule's n = 2 ranking need not be the joint one's, e.g. on McCool's form).
+  const int n_final = opt_.final_joint && opt_.terms <= opt_.joint_polish_terms
+                          ? std::max(opt_.terms, opt_.fit.solve_last)
+                          : opt_.fit.solve_last;
+  for (int j = 0; j < opt_.terms; ++j) {
+    TermRecord rec;
+    std::vector<Config> next = step(beam, j, j + 1 == opt_.terms ? n_final : opt_.fit.solve_last, &rec);
+    if (next.empty()) throw std::runtime_error("structured search: every start of term " + std::to_string(j + 1) +
+                                               " failed to solve");
+    beam = std::move(next);
+    rec.rotation = beam[0].ts.back().R.packed();
+    rec.search_rel_mse = beam[0].value;
+    rec.best_start = beam[0].start;
+    records.push_back(rec);
+    if (opt_.stop_after_term && j + 1 < opt_.terms) {
+      refit(beam[0].ts);
+      if (opt_.stop_after_term(*f)) break;
+    }
+  }
+  std::vector<Term> ts = beam[0].ts;
+  double value = beam[0].value;
+  const int J = static_cast<int>(ts.size());
+  // A stopping rule may end the search early: its configs were scored with solve_last.
+  const int n = J == opt_.terms ? n_final : opt_.fit.solve_last;
+  if (J >= 2 && opt_.polish_sweeps > 0) {
+    // Under the schedule's objective, re-searching an early term re-solves every
+    // later step; only the last solve's terms are polished there.
+    const size_t from = n >= J ? 0 : static_cast<size_t>(J - n);
+    polish(ts, value, from, opt_.polish_sweeps, n, &records.back());
+  }
+  for (size_t i = 0; i < ts.size(); ++i) records[i].rotation = ts[i].R.packed();
+  records.back().search_rel_mse = value;
+  refit(ts);
+  out.factorization = f;
+  out.rel_mse_after_term = errors;
+  out.terms = records;
+  out.search_rel_mse = value;
+  out.beam_rel_mse = {errors.back()};
+  out.evaluations = evaluations_;
+  out.seconds = now_seconds() - t0;
+  return out;
+}
+
+}  // namespace
+
+SearchResult structured_search(const FitData& data, const SearchOptions& opt) {
+  opt.validate();
+  return Structured(data, opt).run();
+}
+
+}  // namespace bf

@@ -1,0 +1,40 @@
+// The structured projection search (SearchOptions::strategy = "structured").
+//
+// Cole's greedy search takes, for each new term, the best single projection;
+// on a BRDF that is exactly two textures a(P1 x) + b(P2 x) the best single
+// plane mixes one direction of each true plane, and no later term undoes it.
+// This search changes what it starts from and what it keeps:
+//  - seeds read off the data: the Hessians of the residual log BRDF (what the
+//    terms so far leave unexplained) are estimated in each parameterization
+//    and the plane pair that block-diagonalizes them gives two starts
+//    (structure.h); with Cole's guesses (wi, wo planes, in each allowed
+//    parameterization, so McCool's p(wi) q(h) p(wo) is inside the space) and
+//    `restarts` seeded random rotations;
+//  - a beam of beam_width partial configurations: at term j every
+//    configuration is extended by every start of its own residual, each
+//    extension scored by one fit (screening); Powell runs from the `keep`
+//    best distinct extensions (in parallel); the next beam holds the best
+//    refined configurations (half of it) and then the best unrefined seed or
+//    guess configurations. Keeping the unrefined true planes is what undoes
+//    the greedy trap: a single plane refined to mix one direction of each
+//    true plane fits better alone, but its pair fits worse;
+//  - polish: at the end, every term of the best configuration is re-searched
+//    with the others held (Jacobi sweeps, in parallel; a move is kept only if
+//    the re-solved objective is lower), polish_sweeps times or until nothing
+//    moves;
+//  - joint refit (final_joint): the found projections are refitted with all
+//    terms solved together; searches of up to joint_polish_terms terms also
+//    polish under that joint objective (the schedule's n = 2 solve cannot
+//    reach McCool's error on a BRDF of exactly McCool's form even at the true
+//    planes).
+// The screening and Powell objective is the greedy search's: the schedule's
+// least-squares error at the search texture size (n = solve_last).
+#pragma once
+
+#include "search/term_search.h"
+
+namespace bf {
+
+SearchResult structured_search(const FitData& data, const SearchOptions& opt);
+
+}  // namespace bf

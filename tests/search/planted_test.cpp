@@ -1,0 +1,206 @@
+// Tests of the structure analysis and the structured search on planted
+// product BRDFs (f = exp(a(P1 x) + b(P2 x) [+ c(P3 x')])): the search must end
+// near the floor, the error of `fit` at the true projections.
+#include <algorithm>
+#include <random>
+
+#include "brdfs/sampleset.h"
+#include "factor/export.h"
+#include "search/planted.h"
+#include "search/structure.h"
+#include "search/term_search.h"
+#include "test_common.h"
+
+using namespace bf;
+
+namespace {
+
+// The floor: fit at the true projections, best order of the terms.
+double floor_error(const PlantedProductBrdf& b, const FitData& d, int res) {
+  std::vector<TermSpec> t = b.specs(res);
+  std::vector<size_t> order(t.size());
+  for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+  double best = 1e300;
+  do {
+    std::vector<TermSpec> s;
+    for (size_t i : order) s.push_back(t[i]);
+    std::vector<double> e;
+    fit_homomorphic(d, s, FitOptions{}, "fit", &e);
+    best = std::min(best, e.back());
+  } while (std::next_permutation(order.begin(), order.end()));
+  return best;
+}
+
+// 2 - |P_a P_b^T|_F^2: 0 for the same plane.
+double plane_distance(const Mat24& a, const Mat24& b) { return 2 - (a * b.transpose()).squaredNorm(); }
+
+Mat24 plane_of(const Rotation4& R) { return R.projection(Parameterization::WiWo, 8).P; }
+
+SearchOptions structured(int terms, int texture) {
+  SearchOptions opt;
+  opt.strategy = "structured";
+  opt.terms = terms;
+  opt.texture_size = texture;
+  return opt;
+}
+
+}  // namespace
+
+TEST_CASE("rotation4: from_matrix inverts matrix") {
+  std::mt19937_64 rng(3);
+  for (int i = 0; i < 50; ++i) {
+    const Rotation4 R = Rotation4::random(rng);
+    const Rotation4 Q = Rotation4::from_matrix(R.matrix());
+    INFO("rotation " << i);
+    CHECK((Q.matrix() - R.matrix()).cwiseAbs().maxCoeff() < 1e-12);
+    CHECK(Q.equal_up_to_sign(R, 1e-10));
+  }
+}
+
+TEST_CASE("structure: local Hessians of a quadratic are its matrix") {
+  std::mt19937_64 rng(4);
+  std::uniform_real_distribution<double> U(-1, 1);
+  Eigen::Matrix4d A;
+  for (int i = 0; i < 4; ++i)
+    for (int j = i; j < 4; ++j) A(i, j) = A(j, i) = U(rng);
+  const Vec4 b(U(rng), U(rng), U(rng), U(rng));
+  std::vector<Vec4> x(20000);
+  std::vector<double> y(x.size());
+  for (size_t k = 0; k < x.size(); ++k) {
+    x[k] = Vec4(U(rng), U(rng), U(rng), U(rng));
+    y[k] = 0.5 * x[k].dot(A * x[k]) + b.dot(x[k]) + 3;
+  }
+  StructureOptions so;
+  so.centres = 50;
+  const auto hs = local_hessians(x, y, {}, so);
+  REQUIRE(hs.size() >= 40);  // a few centres near the cube's corners may have too few neighbours
+  for (const Eigen::Matrix4d& H : hs) CHECK((H - A).cwiseAbs().maxCoeff() < 1e-6);  // measured 6e-8
+}
+
+TEST_CASE("structure: split_planes recovers the planes of block-diagonal Hessians") {
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> U(-1, 1);
+  for (int trial = 0; trial < 5; ++trial) {
+    const Rotation4 R = Rotation4::random(rng);
+    const Eigen::Matrix4d Q = R.matrix();
+    std::vector<Eigen::Matrix4d> hs;
+    for (int k = 0; k < 200; ++k) {
+      Eigen::Matrix4d B = Eigen::Matrix4d::Zero();
+      B(0, 0) = 3 * U(rng), B(1, 1) = 3 * U(rng), B(0, 1) = B(1, 0) = U(rng);
+      B(2, 2) = U(rng), B(3, 3) = U(rng), B(2, 3) = B(3, 2) = 0.5 * U(rng);
+      hs.push_back(Q * B * Q.transpose());
+    }
+    const PlaneSplit s = split_planes(hs);
+    Mat24 A, Bp;
+    A << Q.col(0).transpose(), Q.col(1).transpose();
+    Bp << Q.col(2).transpose(), Q.col(3).transpose();
+    INFO("trial " << trial << ": off-block " << s.off_block << ", share of A " << s.share_a);
+    // Plane A carries more curvature (3x the entries), so it comes first.
+    CHECK(plane_distance(plane_of(s.first), A) < 1e-5);
+    CHECK(plane_distance(plane_of(s.second), Bp) < 1e-5);
+    CHECK(s.off_block < 1e-8);
+    CHECK(s.share_a > 0.5);
+  }
+}
+
+TEST_CASE("structure: the seed planes of a planted two-plane BRDF are near the true ones") {
+  // Grid 10, both parameterizations: the Hessians are estimated, not exact,
+  // so the planes are only close (measured distances 0.002..0.03; bound 0.1).
+  for (Parameterization p : {Parameterization::WiWo, Parameterization::HalfDiff}) {
+    for (int i = 0; i < 2; ++i) {
+      const PlantedProductBrdf b = planted_rotation_brdf(i, 2, p);
+      const SampleSet s = sample_grid(b, 10);
+      const FitData d(s, 1e-5);
+      std::vector<double> y(d.size());
+      for (size_t k = 0; k < y.size(); ++k) y[k] = d.g[0][k];
+      const PlaneSplit sp = split_planes(local_hessians(d.points(p), y, d.w, StructureOptions{}));
+      const Mat24 &A = b.terms()[0].P, &B = b.terms()[1].P;
+      const double d1 = std::min(plane_distance(plane_of(sp.first), A), plane_distance(plane_of(sp.first), B));
+      const double d2 = std::min(plane_distance(plane_of(sp.second), A), plane_distance(plane_of(sp.second), B));
+      INFO(b.to_string() << ": distances " << d1 << ", " << d2 << ", off-block " << sp.off_block);
+      CHECK(d1 < 0.1);
+      CHECK(d2 < 0.1);
+    }
+  }
+}
+
+TEST_CASE("structured search: a planted two-plane BRDF ends near the floor, the greedy search does not") {
+  // Grid 10, texture 8 (small, so the default suite stays fast). Bound: 1.5x the
+  // floor (measured 0.4x..0.9x on members 0..2: the search may also turn the
+  // texture axes inside the true planes, which the floor does not).
+  const PlantedProductBrdf b = planted_rotation_brdf(0, 2, Parameterization::WiWo);
+  const SampleSet s = sample_grid(b, 10);
+  const FitData d(s, 1e-5);
+  const double fl = floor_error(b, d, 8);
+  const SearchResult r = search_factorization(d, structured(2, 8));
+  SearchOptions g = structured(2, 8);
+  g.strategy = "greedy";
+  const SearchResult rg = search_factorization(d, g);
+  INFO("floor " << fl << ", structured " << r.rel_mse_after_term.back() << " (" << r.evaluations
+                << " fits), greedy " << rg.rel_mse_after_term.back() << " (" << rg.evaluations << " fits)");
+  CHECK(r.rel_mse_after_term.back() <= 1.5 * fl);
+  CHECK(rg.rel_mse_after_term.back() > 1.5 * fl);  // the trap this search exists for
+}
+
+TEST_CASE("structured search: deterministic for a seed, whatever the thread count") {
+  const PlantedProductBrdf b = planted_rotation_brdf(1, 2, Parameterization::HalfDiff);
+  const SampleSet s = sample_grid(b, 8);
+  const FitData d(s, 1e-5);
+  SearchOptions opt = structured(2, 6);
+  opt.threads = 1;
+  const SearchResult a = search_factorization(d, opt);
+  opt.threads = 2;
+  const SearchResult c = search_factorization(d, opt);
+  CHECK(a.rel_mse_after_term == c.rel_mse_after_term);
+  CHECK(a.evaluations == c.evaluations);
+  REQUIRE(a.terms.size() == 2);
+  CHECK(a.terms[1].rotation == c.terms[1].rotation);
+}
+
+TEST_CASE("structured search: planted family, both parameterizations, 2 and 3 terms", "[slow]") {
+  // Grid 10, texture 8. Bounds: 2x the floor (2 terms) and 3x (3 terms), the
+  // issue's targets at texture 16 (measured here: docs/search.md).
+  for (int terms : {2, 3})
+    for (Parameterization p : {Parameterization::WiWo, Parameterization::HalfDiff})
+      for (int i = 0; i < 2; ++i) {
+        const PlantedProductBrdf b = planted_rotation_brdf(i, terms, p);
+        const SampleSet s = sample_grid(b, 10);
+        const FitData d(s, 1e-5);
+        const double fl = floor_error(b, d, 8);
+        const SearchResult r = search_factorization(d, structured(terms, 8));
+        INFO(b.to_string() << ": floor " << fl << ", structured " << r.rel_mse_after_term.back());
+        CHECK(r.rel_mse_after_term.back() <= (terms == 2 ? 2.0 : 3.0) * fl);
+      }
+}
+
+TEST_CASE("structured search: McCool's form is inside the search space and survives export") {
+  // f = p(wi) q(h) p(wo): three terms, wiwo, wiwo and halfdiff. Grid 10,
+  // texture 8; measured 0.89x and 1.05x McCool's error on members 0 and 1
+  // (bound 3x, the target).
+  const PlantedProductBrdf b = planted_mccool_brdf(0);
+  const SampleSet s = sample_grid(b, 10);
+  const FitData d(s, 1e-5);
+  std::vector<double> em;
+  fit_homomorphic(d, mccool_terms(8), FitOptions{}, "mccool", &em);
+  const SearchResult r = search_factorization(d, structured(3, 8));
+  INFO("McCool " << em.back() << ", structured " << r.rel_mse_after_term.back() << " (" << r.evaluations
+                 << " fits)");
+  CHECK(r.rel_mse_after_term.back() <= 3 * em.back());
+  int halfdiff = 0;
+  for (const FactorTerm& t : r.factorization->terms()) halfdiff += t.proj.param == Parameterization::HalfDiff;
+  CHECK(halfdiff == 1);  // q(h); p(wi) and p(wo) read the wiwo point
+
+  // Export and reload: the mixed parameterizations evaluate identically.
+  bf_test::TempDir dir("structured_export");
+  const ExportedFiles files = write_factorization(*r.factorization, dir.path.string(), "factors");
+  const auto g = load_factorization(files.sidecar);
+  REQUIRE(g->terms().size() == 3);
+  std::mt19937_64 rng(8);
+  std::uniform_real_distribution<double> U(0, 1);
+  for (int k = 0; k < 200; ++k) {
+    const Vec3 wi = from_spherical(std::acos(std::max(U(rng), 0.05)), 2 * M_PI * U(rng));
+    const Vec3 wo = from_spherical(std::acos(std::max(U(rng), 0.05)), 2 * M_PI * U(rng));
+    const Rgb a = r.factorization->eval(wi, wo), c = g->eval(wi, wo);
+    CHECK((a - c).cwiseAbs().maxCoeff() <= 1e-6 * std::max(1.0, a.cwiseAbs().maxCoeff()));
+  }
+}
