@@ -1,6 +1,8 @@
 // Environment lighting, band limits, lit shading and the SHRM (see lighting.h).
 #include "factor/lighting.h"
 
+#include "brdfs/file_check.h"
+
 #include <OpenImageIO/imageio.h>
 
 #include <algorithm>
@@ -30,6 +32,7 @@ Vec3 LatLongMap::direction(int x, int y, int width, int height) {
 }
 
 LatLongMap read_latlong(const std::string& path) {
+  check_regular_file(path, kMaxImageFileBytes, "environment map");
   auto in = OIIO::ImageInput::open(path);
   if (!in) {
     std::string err = OIIO::geterror();
