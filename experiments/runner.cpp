@@ -1,9 +1,16 @@
 // Experiment runner (see runner.h).
 #include "experiments/runner.h"
 
+#include "brdfs/safe_path.h"
+#include "experiments/interrupt.h"
+#include "experiments/outdir_lock.h"
+
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <new>
 #include <condition_variable>
 #include <cstring>
 #include <filesystem>
@@ -581,7 +588,7 @@ std::optional<RunEntry> load_done_run(const fs::path& exp_dir, const std::string
   for (const auto& [k, v] : rec["row"].items()) e.row[k] = v.is_string() ? v.get<std::string>() : v.dump();
   e.files = rec.value("files", std::vector<std::string>{});
   for (const auto& f : e.files)
-    if (!fs::exists(exp_dir / f, ec)) return std::nullopt;
+    if (!is_path_inside(f) || !fs::exists(exp_dir / f, ec)) return std::nullopt;
   e.record = rec;
   return e;
 }
@@ -670,6 +677,13 @@ RunSummary run_experiment(const RunOptions& opt, std::ostream& out, std::ostream
   sum.out_dir = dir;
   sum.planned = plan.runs.size();
   const fs::path exp_dir(dir);
+  // One writer per output folder, held from before the cache is read until the tables are written.
+  std::optional<OutdirLock> lock;
+  std::optional<InterruptScope> interrupt_scope;  // SIGINT/SIGTERM stop cleanly (experiments/interrupt.h)
+  if (!opt.dry_run) {
+    lock.emplace(dir, "run " + opt.config);
+    interrupt_scope.emplace();
+  }
 
   // Decide what each run of this shard needs.
   enum class Action { Run, Redo, Cached, Forced, OtherShard };
@@ -778,22 +792,24 @@ RunSummary run_experiment(const RunOptions& opt, std::ostream& out, std::ostream
   std::condition_variable cv;
   int free_slots = jobs;
   size_t next = 0, done = 0;
+  int busy = 0, exited = 0;  // workers inside a run; workers that returned
   const auto start = Clock::now();
   const size_t total = todo.size();
-  auto worker = [&] {
+  auto work = [&] {
     for (;;) {
       size_t i;
       int w;
       {
         std::unique_lock<std::mutex> lk(mu);
-        if (next >= todo.size()) return;
+        if (next >= todo.size() || interrupt_signal()) return;
         // Take the next run in plan order once enough slots are free.
         cv.wait(lk, [&] {
-          if (next >= todo.size()) return true;
+          if (next >= todo.size() || interrupt_signal()) return true;
           const int need = std::min(jobs, plan.methods[plan.runs[todo[next]].method].cores);
           return free_slots >= need;
         });
-        if (next >= todo.size()) return;
+        if (next >= todo.size() || interrupt_signal()) return;
+        ++busy;
         i = todo[next++];
         w = std::min(jobs, plan.methods[plan.runs[i].method].cores);
         free_slots -= w;
@@ -814,7 +830,8 @@ RunSummary run_experiment(const RunOptions& opt, std::ostream& out, std::ostream
         e.status = "failed";
         set_presentation(e.row, plan, r);
         e.row["status"] = "failed";
-        e.row["notes"] = std::string("failed: ") + ex.what();
+        const bool oom = dynamic_cast<const std::bad_alloc*>(&ex) != nullptr;  // never "std::bad_alloc" alone
+        e.row["notes"] = std::string("failed: ") + (oom ? "out of memory" : ex.what());
         e.record = {{"run_id", r.run_id}, {"error", ex.what()}, {"method", plan.methods[r.method].options}};
       }
       e.shard = opt.shard;
@@ -822,6 +839,7 @@ RunSummary run_experiment(const RunOptions& opt, std::ostream& out, std::ostream
         std::unique_lock<std::mutex> lk(mu);
         entries[i] = std::move(e);
         free_slots += w;
+        --busy;
         ++done;
         if (!opt.quiet) {
           const double el = since(start);
@@ -837,31 +855,90 @@ RunSummary run_experiment(const RunOptions& opt, std::ostream& out, std::ostream
       cv.notify_all();
     }
   };
+  auto worker = [&] {
+    work();
+    {
+      std::unique_lock<std::mutex> lk(mu);
+      ++exited;
+    }
+    cv.notify_all();
+  };
+  int stopped_by = 0;    // the signal that stopped the runs, or 0
+  bool abandon = false;  // runs still executing when the signal came: exit without waiting for them
   {
     std::vector<std::thread> pool;
     const int n_threads = std::min<int>(jobs, static_cast<int>(todo.size()));
     for (int t = 0; t < n_threads; ++t) pool.emplace_back(worker);
-    for (auto& t : pool) t.join();
+    {
+      std::unique_lock<std::mutex> lk(mu);
+      while (exited < n_threads && !interrupt_signal()) cv.wait_for(lk, std::chrono::milliseconds(100));
+      stopped_by = exited < n_threads || done < total ? interrupt_signal() : 0;
+      if (stopped_by) {
+        cv.notify_all();  // idle workers see the signal and return
+        abandon = busy > 0;
+        if (!abandon)
+          while (exited < n_threads) cv.wait_for(lk, std::chrono::milliseconds(100));
+      }
+    }
+    if (abandon) {
+      for (auto& t : pool) t.detach();  // the process ends below without returning (_Exit)
+    } else {
+      for (auto& t : pool) t.join();
+    }
   }
+  std::vector<RunEntry> finished;
+  {
+    std::unique_lock<std::mutex> lk(mu);
+    finished = entries;  // a snapshot: abandoned workers may still write entries
+  }
+  size_t unfinished = 0;
+  if (stopped_by)
+    for (size_t i : todo)
+      if (finished[i].run_id.empty()) {
+        ++unfinished;
+        RunEntry& e = finished[i];
+        e.run_id = plan.runs[i].run_id;
+        e.status = "interrupted";
+        e.shard = opt.shard;
+        set_presentation(e.row, plan, plan.runs[i]);
+        e.row["status"] = "interrupted";
+        e.row["notes"] = "interrupted by " + signal_name(stopped_by) + " before it finished; the next run does it";
+        e.record = {{"run_id", e.run_id}, {"error", "interrupted"}, {"method", plan.methods[plan.runs[i].method].options}};
+      }
 
   ExperimentOutput o = base_output(plan, dir, opt.shard, opt.shards);
   o.plots = opt.plots && plan.experiment.plots;
   for (size_t i = 0; i < plan.runs.size(); ++i) {
     if (action[i] == Action::OtherShard) continue;
-    entries[i].shard = entries[i].shard ? entries[i].shard : opt.shard;
-    if (entries[i].status == "ok") {
+    finished[i].shard = finished[i].shard ? finished[i].shard : opt.shard;
+    if (finished[i].status == "ok") {
       if (action[i] == Action::Cached) ++sum.cached;
       else ++sum.executed;
       if (action[i] == Action::Redo) ++sum.redone;
-    } else {
+    } else if (finished[i].status != "interrupted") {
       ++sum.failed;
     }
-    o.runs.push_back(entries[i]);
+    o.runs.push_back(finished[i]);
   }
   sum.files = write_experiment_outputs(o, opt.quiet ? nullptr : &err);
   if (!opt.quiet)
     err << "experiment " << plan.experiment.name << ": " << sum.executed << " run, " << sum.cached
         << " cached, " << sum.failed << " failed in " << hms(since(start)) << "\n";
+  if (stopped_by) {
+    const std::string msg = "interrupted by " + signal_name(stopped_by) + ": " +
+                            std::to_string(sum.in_shard - unfinished) + " of " + std::to_string(sum.in_shard) +
+                            " runs are finished and written to " + sum.files.results_md + ", " +
+                            std::to_string(unfinished) +
+                            " are not (marked interrupted); run the same command again to resume "
+                            "(finished runs are reused)";
+    if (abandon) {  // runs still executing on detached threads: end the process here
+      err << "brdf-factor: " << msg << "\n";
+      err.flush();
+      std::fflush(nullptr);
+      std::_Exit(128 + stopped_by);
+    }
+    throw Interrupted(msg, stopped_by);
+  }
   print_results(out, sum.files);
   if (sum.failed) {
     std::string first;
@@ -946,6 +1023,7 @@ RunSummary merge_experiments(const std::vector<std::string>& dirs, const std::st
 
   // Copy the run folders and write the merged folder.
   const fs::path odir(out_dir);
+  const OutdirLock lock(out_dir, "merge");
   fs::create_directories(odir / "runs");
   ExperimentOutput o;
   o.dir = out_dir;
