@@ -1,9 +1,12 @@
 // Catalogue implementation (see catalogue.h).
 #include "brdfs/catalogue.h"
 
+#include "brdfs/file_check.h"
+
 #include <cstdlib>
 #include <filesystem>
 #include <stdexcept>
+#include <vector>
 
 namespace bf {
 
@@ -57,8 +60,27 @@ BrdfPtr Catalogue::load_file(const std::string& path, ParamDict& options) const 
     throw std::invalid_argument(path + ": unknown measured-file extension '" + ext +
                                 "' (accepted: " + acc + ")");
   }
-  if (!std::filesystem::exists(path))
-    throw std::invalid_argument(path + ": file not found");
+  check_regular_file(path, kMaxDataFileBytes, "");
+  // A file may name another file (a model fit's spec); a chain that comes
+  // back to a file being loaded, or is deeper than kMaxFileNesting, is an
+  // error instead of unbounded recursion.
+  thread_local std::vector<std::string> loading;
+  std::error_code ec;
+  std::string key = std::filesystem::weakly_canonical(path, ec).string();
+  if (ec) key = path;
+  std::string chain;
+  for (const auto& p : loading) chain += p + " -> ";
+  for (const auto& p : loading)
+    if (p == key)
+      throw std::invalid_argument(path + ": refers back to a file being loaded (" + chain + key + ")");
+  if (loading.size() >= kMaxFileNesting)
+    throw std::invalid_argument(path + ": files name each other more than " + std::to_string(kMaxFileNesting) +
+                                " deep (" + chain + key + ")");
+  loading.push_back(key);
+  struct Pop {
+    std::vector<std::string>& v;
+    ~Pop() { v.pop_back(); }
+  } pop{loading};
   return it->second(path, options);
 }
 

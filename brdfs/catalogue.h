@@ -58,7 +58,11 @@ class Catalogue {
   BrdfPtr make(const std::string& spec, const std::string& origin = "--brdf") const;
   // Build a model or preset by name from an already-filled dict (configs).
   BrdfPtr make(const std::string& name, ParamDict& params) const;
+  // Loads a file through its extension's loader. A file that names another
+  // file (a model fit's spec) is followed at most kMaxFileNesting deep; a
+  // chain back to a file being loaded throws std::invalid_argument naming it.
   BrdfPtr load_file(const std::string& path, ParamDict& options) const;
+  static constexpr size_t kMaxFileNesting = 8;
 
   const std::map<std::string, ModelInfo>& models() const { return models_; }
   const std::map<std::string, PresetInfo>& presets() const { return presets_; }

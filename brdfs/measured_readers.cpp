@@ -7,6 +7,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "brdfs/file_check.h"
 #include "brdfs/directions.h"
 #include "brdfs/measured.h"
 #include "brdfs/measured_text.h"
@@ -102,6 +103,7 @@ void push_record(SpectralMeasurements& m, const std::string& at, const double* v
 }  // namespace
 
 SpectralMeasurements read_astm(const std::string& path) {
+  check_regular_file(path, kMaxDataFileBytes, "ASTM file");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw std::invalid_argument(path + ": cannot open ASTM file");
   SpectralMeasurements m;
@@ -174,6 +176,7 @@ SpectralMeasurements read_astm(const std::string& path) {
 }
 
 SpectralMeasurements read_pbrt_brdf(const std::string& path) {
+  check_regular_file(path, kMaxDataFileBytes, "pbrt .brdf file");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw std::invalid_argument(path + ": cannot open pbrt .brdf file");
   SpectralMeasurements m;

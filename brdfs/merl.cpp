@@ -1,6 +1,8 @@
 // MERL .binary reader/writer, MERL half/difference angles and MerlBrdf (see merl.h).
 #include "brdfs/merl.h"
 
+#include "brdfs/temp_file.h"
+
 #include <algorithm>
 #include <bit>
 #include <cmath>
@@ -192,7 +194,7 @@ void write_merl(const MerlTable& table, const std::string& path) {
     if (!std::isfinite(table.raw[i]))
       throw std::invalid_argument(path + ": merl: refusing to write a non-finite value in the " +
                                   kChannel[i / kMerlCells] + " block at " + bin_of(i % kMerlCells));
-  const std::string tmp = path + ".tmp";
+  const std::string tmp = create_unique_temp(path);
   {
     std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
     if (!out) throw std::runtime_error(path + ": merl: cannot open " + tmp + " for writing");

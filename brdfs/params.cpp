@@ -2,21 +2,25 @@
 #include "brdfs/params.h"
 
 #include <cmath>
+#include <cctype>
+#include <cerrno>
+#include <cstdlib>
 #include <sstream>
 #include <stdexcept>
 
 namespace bf {
 
 namespace {
+// strtod, not std::stod: stod throws out_of_range for an underflow such as
+// 1e-320 (a denormal, a valid number that validation then judges), which
+// read as "expects one number".
 bool parse_double(const std::string& s, double& out) {
-  if (s.empty()) return false;
-  try {
-    size_t pos = 0;
-    out = std::stod(s, &pos);
-    return pos == s.size() && std::isfinite(out);
-  } catch (const std::exception&) {
-    return false;
-  }
+  if (s.empty() || std::isspace(static_cast<unsigned char>(s[0]))) return false;
+  char* end = nullptr;
+  errno = 0;
+  out = std::strtod(s.c_str(), &end);
+  if (end != s.c_str() + s.size()) return false;
+  return std::isfinite(out) && (errno != ERANGE || std::abs(out) < 1.0);
 }
 
 std::string trim(const std::string& s) {

@@ -1,4 +1,7 @@
 // Sample-list CSV reader and writer (see sample_csv.h).
+#include "brdfs/file_check.h"
+
+#include "brdfs/temp_file.h"
 #include "brdfs/sample_csv.h"
 
 #include <cmath>
@@ -47,6 +50,7 @@ void angles_for_csv(const Vec3& w, double& theta, double& phi) {
 }  // namespace
 
 SampleSet read_sample_csv(const std::string& path) {
+  check_regular_file(path, kMaxDataFileBytes, "sample list");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw std::invalid_argument(path + ": cannot open sample list");
   SampleSet s;
@@ -122,7 +126,7 @@ void write_sample_csv(const SampleSet& s, const std::string& path) {
   std::string desc = s.description;
   for (char& c : desc)
     if (c == '\n' || c == '\r') c = ' ';
-  const std::string tmp = path + ".tmp";
+  const std::string tmp = create_unique_temp(path);
   {
     std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
     if (!out) throw std::runtime_error(path + ": cannot open " + tmp + " for writing");

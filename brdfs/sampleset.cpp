@@ -83,6 +83,10 @@ void evaluate_into(const Brdf& brdf, SampleSet& s) {
 }
 
 SampleSet sample_grid(const Brdf& brdf, int res) {
+  if (res > kMaxSampleGridResolution)
+    throw std::invalid_argument("grid resolution: expected 2.." + std::to_string(kMaxSampleGridResolution) +
+                                " for a sample grid (res^4 pairs: 64 gives about 1e7), found " +
+                                std::to_string(res));
   const std::vector<Vec3> dirs = grid_directions(res);
   SampleSet s;
   s.wi.reserve(dirs.size() * dirs.size());
@@ -99,9 +103,10 @@ SampleSet sample_grid(const Brdf& brdf, int res) {
 }
 
 SampleSet sample_stratified(const Brdf& brdf, size_t count, uint64_t seed) {
-  if (count == 0 || count > 100000000)
-    throw std::invalid_argument("stratified count: expected 1..1e8, found " +
-                                std::to_string(count));
+  // About 200 bytes per pair while building (stratification tables and the set).
+  if (count == 0 || count > kMaxStratifiedCount)
+    throw std::invalid_argument("stratified count: expected 1.." + std::to_string(kMaxStratifiedCount) +
+                                " (about 2 GB while sampling), found " + std::to_string(count));
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> U(0.0, 1.0);
   std::vector<std::vector<double>> u(4, std::vector<double>(count));

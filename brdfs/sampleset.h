@@ -41,13 +41,18 @@ struct SampleSet {
 // (-1 + (k + 0.5) * 2 / res), kept where both parabolic points lie in the unit
 // disk. res = 16 gives 208 directions per disk and 43,264 pairs.
 // Throws std::invalid_argument for res < 2 or res > 256.
+// Throws std::invalid_argument for res > kMaxSampleGridResolution (bounded
+// memory: about 1e7 pairs at 64).
+inline constexpr int kMaxSampleGridResolution = 64;
 SampleSet sample_grid(const Brdf& brdf, int res);
 // Directions of the res x res grid that lie in the disk (the per-disk set above).
 std::vector<Vec3> grid_directions(int res);
 
 // count pairs, Latin-hypercube stratified in (cos theta_i, phi_i, cos theta_o,
 // phi_o), uniform in solid angle; deterministic for a seed.
-// Throws std::invalid_argument for count == 0 or count > 1e8.
+// Throws std::invalid_argument for count == 0 or count > kMaxStratifiedCount
+// (bounded memory: about 200 bytes per pair while sampling).
+inline constexpr size_t kMaxStratifiedCount = 10000000;
 SampleSet sample_stratified(const Brdf& brdf, size_t count, uint64_t seed);
 
 // Evaluates brdf at the given direction pairs (values of an existing set are replaced).

@@ -1,7 +1,11 @@
 // CLI helpers (see cli_util.h).
 #include "experiments/cli_util.h"
 
+#include "brdfs/temp_file.h"
+
+#include <cerrno>
 #include <cmath>
+#include <cstdlib>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -16,14 +20,13 @@ Vec3 parse_direction(const std::string& text, const std::string& what) {
   std::stringstream ss(text);
   std::string part;
   while (std::getline(ss, part, ',')) {
-    try {
-      size_t pos = 0;
-      const double d = std::stod(part, &pos);
-      if (pos != part.size() || !std::isfinite(d)) throw std::invalid_argument("x");
-      v.push_back(d);
-    } catch (const std::exception&) {
-      throw std::invalid_argument(what + ": expected three numbers x,y,z, found '" + text + "'");
-    }
+    char* end = nullptr;
+    errno = 0;
+    const double d = std::strtod(part.c_str(), &end);  // an underflow (1e-320) is a number
+    if (part.empty() || end != part.c_str() + part.size() || !std::isfinite(d) ||
+        (errno == ERANGE && std::abs(d) >= 1.0))
+      throw std::invalid_argument(what + ": expected three finite numbers x,y,z, found '" + text + "'");
+    v.push_back(d);
   }
   if (v.size() != 3)
     throw std::invalid_argument(what + ": expected three numbers x,y,z, found " +
@@ -44,7 +47,7 @@ void write_file_atomic(const std::string& path, const std::function<void(std::os
       throw std::runtime_error(path + ": cannot create folder " + p.parent_path().string() + ": " +
                                ec.message());
   }
-  const std::string tmp = path + ".tmp";
+  const std::string tmp = create_unique_temp(path);
   {
     std::ofstream out(tmp, std::ios::binary);
     if (!out) throw std::runtime_error(path + ": cannot open for writing");

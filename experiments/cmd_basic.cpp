@@ -2,6 +2,7 @@
 #include <iomanip>
 #include <iostream>
 #include <memory>
+#include <sstream>
 
 #include "brdfs/catalogue.h"
 #include "brdfs/sample_csv.h"
@@ -53,6 +54,15 @@ void add_cmd_eval(CLI::App& app) {
   cmd->callback([=] {
     const BrdfPtr b = Catalogue::builtin().make(*spec);
     const Rgb f = b->eval(parse_direction(*wi, "--wi"), parse_direction(*wo, "--wo"));
+    // Parameters validation accepts can still overflow double arithmetic
+    // (Cook-Torrance m = 1e-200: m^2 is 0): never print inf or nan.
+    if (!f.isFinite().all()) {
+      std::ostringstream v;
+      v << f[0] << " " << f[1] << " " << f[2];
+      throw std::invalid_argument("eval: --brdf " + *spec + " at --wi " + *wi + " --wo " + *wo +
+                                  ": expected a finite value, found " + v.str() +
+                                  " (the parameters are outside what double precision can evaluate)");
+    }
     std::cout << std::setprecision(10) << f[0] << " " << f[1] << " " << f[2] << "\n";
   });
 }

@@ -52,7 +52,17 @@ struct BenchFitArgs {
 
 void run_bench_fit(const BenchFitArgs& a) {
   if (a.repeats < 1) throw std::invalid_argument("--repeats: expected >= 1, found " + std::to_string(a.repeats));
-  if (a.terms < 1) throw std::invalid_argument("--terms: expected >= 1, found " + std::to_string(a.terms));
+  if (a.terms < 1 || a.terms > 1024)
+    throw std::invalid_argument("--terms: expected 1..1024, found " + std::to_string(a.terms));
+  if (a.texture < 2 || a.texture > 1024)
+    throw std::invalid_argument("--texture: expected 2..1024, found " + std::to_string(a.texture));
+  if (uint64_t(a.terms) * uint64_t(a.texture) * uint64_t(a.texture) > kMaxTotalTexels)
+    throw std::invalid_argument("--terms x --texture^2: expected at most " + std::to_string(kMaxTotalTexels) +
+                                " texels, found " + std::to_string(a.terms) + " x " + std::to_string(a.texture) +
+                                "^2");
+  if (a.samples < 0 || uint64_t(a.samples) > kMaxStratifiedCount)
+    throw std::invalid_argument("--samples: expected 0.." + std::to_string(kMaxStratifiedCount) + ", found " +
+                                std::to_string(a.samples));
   const BrdfPtr brdf = Catalogue::builtin().make(a.brdf);
   const SampleSet s = a.samples > 0 ? sample_stratified(*brdf, static_cast<size_t>(a.samples), a.seed)
                                     : sample_grid(*brdf, a.grid);

@@ -18,7 +18,7 @@ void add_cmd_export_merl(CLI::App& app) {
   cmd->add_option("--brdf", *spec,
                   "catalogue name[:k=v,...] or measured file (.astm, .brdf, .csv, .binary)")
       ->required();
-  cmd->add_option("--out", *out, "output file (34,992,012 bytes; written via FILE.tmp + rename)")
+  cmd->add_option("--out", *out, "output file (34,992,012 bytes; written via a unique temporary + rename)")
       ->required();
   cmd->callback([=] {
     // Everything that can fail on the input happens before anything is written.

@@ -15,7 +15,12 @@
 #include <unordered_map>
 
 #include "brdfs/catalogue.h"
+#include "brdfs/file_check.h"
 #include "brdfs/params.h"
+#include "brdfs/safe_path.h"
+#include "brdfs/sampleset.h"
+#include "experiments/plan_size.h"
+#include "experiments/toml_depth.h"
 #include "experiments/cli_util.h"
 #include "experiments/config_reader.h"
 #include "experiments/methods/method_kind.h"
@@ -56,6 +61,7 @@ std::string content_hash(const std::string& bytes) {
 }
 
 std::string file_hash(const std::string& path) {
+  check_regular_file(path, kMaxImageFileBytes, "");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw std::invalid_argument(path + ": cannot read");
   std::ostringstream ss;
@@ -126,8 +132,9 @@ ExperimentSettings read_experiment(const toml::table* t, Ctx& ctx, const std::st
   const Combo c = plain_combo(*t);
   Reader r(ctx, c, "experiment", ctx.where(*t));
   e.name = r.text("name", e.name);
-  if (e.name.empty() || e.name.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789._-") != std::string::npos)
-    r.fail("name", "expected a non-empty name of letters, digits, '.', '_' and '-', found \"" + e.name + "\"");
+  if (!is_plain_name(e.name))
+    r.fail("name", "expected a non-empty name of letters, digits, '.', '_' and '-', not '.' or '..', found " +
+                       quote_for_message(e.name));
   e.seed = static_cast<uint64_t>(r.integer("seed", 1, 0, kIntMax));
   e.out = r.text("out", "results/" + e.name);
   if (e.out.empty()) r.fail("out", "expected a folder path, found \"\"");
@@ -445,11 +452,15 @@ void read_samplings(const toml::node* node, Ctx& ctx, uint64_t base_seed,
       if (r.failed()) continue;
       if (s.kind == "grid") {
         s.resolution = static_cast<int>(r.integer("resolution", 16, 2, 256));
+        if (s.resolution > kMaxSampleGridResolution)  // brdfs/sampleset.h: bounded memory
+          r.fail("resolution", "expected at most " + std::to_string(kMaxSampleGridResolution) +
+                                   " (a res^4 grid: 64 gives about 1e7 pairs), found " +
+                                   std::to_string(s.resolution));
         s.label = "grid " + std::to_string(s.resolution) + "^4";
         s.identity = {{"kind", "grid"}, {"resolution", s.resolution}};
       } else if (s.kind == "stratified") {
         if (!r.has("count")) r.fail_table("kind = \"stratified\" needs count = <number of pairs>");
-        s.count = static_cast<uint64_t>(r.integer("count", 1, 1, 100000000));
+        s.count = static_cast<uint64_t>(r.integer("count", 1, 1, static_cast<long long>(kMaxStratifiedCount)));
         s.seed = static_cast<uint64_t>(r.integer("seed", static_cast<int64_t>(base_seed), 0, kIntMax));
         s.label = "stratified " + std::to_string(s.count) + " seed " + std::to_string(s.seed);
         s.identity = {{"kind", "stratified"}, {"count", s.count}, {"seed", s.seed}};
@@ -571,10 +582,24 @@ void read_methods(const toml::node* node, Ctx& ctx, uint64_t base_seed, std::vec
 
 // ------------------------------------------------------------------ plan
 
+// Counts the runs (experiments/plan_size.h) before anything is expanded.
+static void check_plan_size_before_expanding(const toml::table& root, const std::string& path) {
+  const uint64_t cap = kMaxRuns;
+  const uint64_t b = count_section_combinations(root.get("brdf"), brdf_array_is_value, cap);
+  const uint64_t s = count_section_combinations(root.get("sampling"), never_value, cap);
+  const uint64_t m = count_section_combinations(root.get("method"), method_array_is_value, cap);
+  if (saturating_product(saturating_product(b, s, cap), m, cap) <= cap) return;
+  auto n = [&](uint64_t x) { return x > cap ? "more than " + std::to_string(cap) : std::to_string(x); };
+  throw ConfigError({path + ": experiment: the config expands to more than " + std::to_string(cap) +
+                     " runs (limit " + std::to_string(cap) + "): " + n(b) + " brdf x " + n(s) + " sampling x " +
+                     n(m) + " method combinations; nothing was expanded"});
+}
+
 Plan parse_plan(const std::string& text, const std::string& path, const std::vector<std::string>& defines) {
   Ctx ctx;
   ctx.path = path;
   ctx.dir = fs::path(path).parent_path().string();
+  if (std::string p = toml_key_depth_problem(text, path); !p.empty()) throw ConfigError({p});
   toml::table root;
   try {
     root = toml::parse(text, path);
@@ -583,6 +608,7 @@ Plan parse_plan(const std::string& text, const std::string& path, const std::vec
                        std::string(e.description())});
   }
   for (const auto& d : defines) apply_define(root, d, ctx);
+  check_plan_size_before_expanding(root, path);
 
   Plan plan;
   plan.config_path = path;
@@ -659,11 +685,7 @@ Plan parse_plan(const std::string& text, const std::string& path, const std::vec
 }
 
 Plan load_plan(const std::string& path, const std::vector<std::string>& defines) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw std::invalid_argument(path + ": cannot open the config file");
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return parse_plan(ss.str(), path, defines);
+  return parse_plan(read_regular_file(path, kMaxTextFileBytes, "config"), path, defines);
 }
 
 }  // namespace bf

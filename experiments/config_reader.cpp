@@ -6,6 +6,8 @@
 #include <filesystem>
 #include <sstream>
 
+#include "experiments/toml_depth.h"
+
 #include "brdfs/catalogue.h"
 #include "brdfs/params.h"
 #include "experiments/cli_util.h"
@@ -137,13 +139,14 @@ bool parse_path(const std::string& key, std::vector<PathSeg>& segs) {
     if (lb != std::string::npos) {
       if (part.back() != ']') return false;
       const std::string num = part.substr(lb + 1, part.size() - lb - 2);
-      if (num.empty() || num.find_first_not_of("0123456789") != std::string::npos) return false;
+      if (num.empty() || num.size() > 6 || num.find_first_not_of("0123456789") != std::string::npos) return false;
       s.index = std::stoi(num);
       part = part.substr(0, lb);
     }
     if (part.empty()) return false;
     s.name = part;
     segs.push_back(s);
+    if (segs.size() > 16) return false;  // a define path is section.key or section.key.subkey
   }
   return !segs.empty();
 }
@@ -180,7 +183,9 @@ void apply_define(toml::table& root, const std::string& def, Ctx& ctx) {
   // The value: TOML if it parses as one, else the text as a string.
   toml::table parsed;
   try {
-    parsed = toml::parse("v = " + text, origin);
+    // Too deep to parse safely: taken as a string, like any text that is not TOML.
+    if (toml_key_depth_problem("v = " + text, origin).empty()) parsed = toml::parse("v = " + text, origin);
+    else parsed.insert_or_assign("v", text);
   } catch (const toml::parse_error&) {
     parsed.insert_or_assign("v", text);
   }

@@ -2,10 +2,12 @@
 // commands.h; every error becomes one line on stderr and exit code 2.
 #include <CLI/CLI.hpp>
 #include <exception>
+#include <new>
 #include <iostream>
 
 #include "brdfs/catalogue.h"
 #include "experiments/commands.h"
+#include "experiments/interrupt.h"
 #include "factor/export.h"
 
 int main(int argc, char** argv) {
@@ -30,6 +32,13 @@ int main(int argc, char** argv) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
     std::cerr << "brdf-factor: " << e.what() << " (see brdf-factor --help)\n";
+    return 2;
+  } catch (const bf::Interrupted& e) {
+    std::cerr << "brdf-factor: " << e.what() << "\n";
+    return 128 + e.signal();
+  } catch (const std::bad_alloc&) {
+    std::cerr << "brdf-factor: out of memory: the input asks for more memory than this machine has "
+                 "(the bounds are in docs/robustness.md)\n";
     return 2;
   } catch (const std::exception& e) {
     std::cerr << "brdf-factor: " << e.what() << "\n";

@@ -1,6 +1,9 @@
 // Experiment folder outputs (see outputs.h).
 #include "experiments/outputs.h"
 
+#include "brdfs/file_check.h"
+#include "brdfs/safe_path.h"
+
 #include <Eigen/Core>
 #include <ceres/version.h>
 
@@ -397,6 +400,7 @@ OutputFiles write_experiment_outputs(const ExperimentOutput& e, std::ostream* lo
 
 ExperimentOutput read_experiment_manifest(const std::string& dir) {
   const std::string path = (fs::path(dir) / "manifest.json").string();
+  if (fs::exists(path)) check_regular_file(path, kMaxTextFileBytes, "manifest");
   std::ifstream in(path);
   if (!in) throw std::invalid_argument(path + ": not found (is " + dir + " an experiment folder written by `run`?)");
   json m;
@@ -428,16 +432,29 @@ ExperimentOutput read_experiment_manifest(const std::string& dir) {
   e.shard = sh.value("k", 1);
   e.shards = sh.value("n", 1);
   e.plan = need("plan", json::value_t::array);
+  // Names read from the manifest become paths (runs/<run_id>): plain names only.
+  for (size_t i = 0; i < e.plan.size(); ++i) {
+    const std::string where = path + ": plan[" + std::to_string(i) + "].run_id";
+    const json& p = e.plan[i];
+    if (!p.is_object() || !p.contains("run_id") || !p["run_id"].is_string())
+      throw std::invalid_argument(where + ": expected a string");
+    require_plain_name(p["run_id"].get<std::string>(), where);
+  }
+  size_t index = 0;
   for (const json& r : need("runs", json::value_t::array)) {
+    const std::string where = path + ": runs[" + std::to_string(index++) + "]";
+    if (!r.is_object()) throw std::invalid_argument(where + ": expected an object");
     RunEntry re;
     re.run_id = r.value("run_id", "");
     re.status = r.value("status", "");
     re.shard = r.value("shard", 1);
     if (re.run_id.empty()) throw std::invalid_argument(path + ": runs: an entry without run_id");
+    require_plain_name(re.run_id, where + ".run_id");
     const json row = r.value("row", json::object());
     for (const auto& [k, v] : row.items())
       re.row[k] = v.is_string() ? v.get<std::string>() : v.dump();
     re.files = r.value("files", std::vector<std::string>{});
+    for (const auto& f : re.files) require_path_inside(f, where + ".files", "the experiment folder");
     re.record = r;
     e.runs.push_back(std::move(re));
   }

@@ -1,6 +1,7 @@
 // Sphere pictures and shade_rmse (see render.h).
 #include "experiments/render.h"
 
+#include "brdfs/temp_file.h"
 #include "factor/image_io.h"
 
 #include <algorithm>
@@ -154,10 +155,7 @@ void write_comparison_png(const SphereRender& original, const SphereRender& appr
     }
   namespace fs = std::filesystem;
   const fs::path final_path(path);
-  std::string tmp_name(".");
-  tmp_name += final_path.filename().string();
-  tmp_name += ".tmp.png";
-  const fs::path tmp = final_path.parent_path() / tmp_name;
+  const fs::path tmp = create_unique_temp(path);
   try {
     bf::write_png_rgb8(tmp.string(), W, n, px);
   } catch (const std::exception& e) {

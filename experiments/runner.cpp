@@ -1,7 +1,14 @@
 // Experiment runner (see runner.h).
 #include "experiments/runner.h"
 
+#include "brdfs/safe_path.h"
+#include "experiments/interrupt.h"
+#include "experiments/outdir_lock.h"
+
 #include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <new>
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
@@ -266,7 +273,7 @@ std::optional<RunEntry> load_done_run(const fs::path& exp_dir, const std::string
   for (const auto& [k, v] : rec["row"].items()) e.row[k] = v.is_string() ? v.get<std::string>() : v.dump();
   e.files = rec.value("files", std::vector<std::string>{});
   for (const auto& f : e.files)
-    if (!fs::exists(exp_dir / f, ec)) return std::nullopt;
+    if (!is_path_inside(f) || !fs::exists(exp_dir / f, ec)) return std::nullopt;
   e.record = rec;
   return e;
 }
@@ -308,45 +315,65 @@ void print_results(std::ostream& out, const OutputFiles& f) {
   out << "report:  " << f.report << "\n";
 }
 
+// How execute_in_parallel ended: stopped_by is the signal (SIGINT/SIGTERM)
+// that stopped it, 0 when every run finished; abandon when runs were still
+// executing then (their threads are detached: the caller must end the process
+// without returning, see run_experiment).
+struct PoolEnd {
+  int stopped_by = 0;
+  bool abandon = false;
+};
+
 // Executes the runs `todo` (plan indices, plan order) on `jobs` slots: each
 // run holds min(jobs, its method's cores) slots (runner.h), progress on err.
-void execute_in_parallel(const Plan& plan, const std::vector<size_t>& todo, int jobs,
-                         const std::map<std::string, std::shared_ptr<const SampleSet>>& samples,
-                         const fs::path& exp_dir, const json& build, const RunOptions& opt, std::ostream& err,
-                         std::vector<RunEntry>& entries) {
-  RenderCache renders;
-  std::mutex mu;
-  std::condition_variable cv;
-  int free_slots = jobs;
-  size_t next = 0, done = 0;
+// A signal (experiments/interrupt.h) stops taking new runs; entries then
+// holds the finished ones (a snapshot, under the pool's lock).
+PoolEnd execute_in_parallel(const Plan& plan, const std::vector<size_t>& todo, int jobs,
+                            const std::map<std::string, std::shared_ptr<const SampleSet>>& samples,
+                            const fs::path& exp_dir, const json& build, const RunOptions& opt, std::ostream& err,
+                            std::vector<RunEntry>& entries) {
+  // The pool's state outlives this call when workers are abandoned (detached).
+  struct State {
+    RenderCache renders;
+    std::mutex mu;
+    std::condition_variable cv;
+    int free_slots = 0;
+    size_t next = 0, done = 0;
+    int busy = 0, exited = 0;  // workers inside a run; workers that returned
+    std::vector<RunEntry> entries;
+  };
+  auto st = std::make_shared<State>();
+  st->free_slots = jobs;
+  st->entries = entries;
   const auto start = Clock::now();
   const size_t total = todo.size();
-  auto worker = [&] {
+  auto work = [&plan, &todo, jobs, &samples, &exp_dir, &build, &opt, &err, start, total](State& s) {
     for (;;) {
       size_t i;
       int w;
       {
-        std::unique_lock<std::mutex> lk(mu);
-        if (next >= todo.size()) return;
+        std::unique_lock<std::mutex> lk(s.mu);
+        if (s.next >= todo.size() || interrupt_signal()) return;
         // Take the next run in plan order once enough slots are free.
-        cv.wait(lk, [&] {
-          if (next >= todo.size()) return true;
-          const int need = std::min(jobs, plan.methods[plan.runs[todo[next]].method].cores);
-          return free_slots >= need;
+        s.cv.wait(lk, [&] {
+          if (s.next >= todo.size() || interrupt_signal()) return true;
+          const int need = std::min(jobs, plan.methods[plan.runs[todo[s.next]].method].cores);
+          return s.free_slots >= need;
         });
-        if (next >= todo.size()) return;
-        i = todo[next++];
+        if (s.next >= todo.size() || interrupt_signal()) return;
+        ++s.busy;
+        i = todo[s.next++];
         w = std::min(jobs, plan.methods[plan.runs[i].method].cores);
-        free_slots -= w;
+        s.free_slots -= w;
         if (!opt.quiet)
-          err << "start " << next << "/" << total << " " << plan.runs[i].run_id << " "
+          err << "start " << s.next << "/" << total << " " << plan.runs[i].run_id << " "
               << describe_run(plan, plan.runs[i]) << "\n";
       }
       const PlannedRun& r = plan.runs[i];
       const auto t0 = Clock::now();
       RunEntry e;
       try {
-        e = execute_run(plan, r, *samples.at(r.samples_key), exp_dir, renders, build);
+        e = execute_run(plan, r, *samples.at(r.samples_key), exp_dir, s.renders, build);
       } catch (const std::exception& ex) {
         std::error_code ec;
         fs::remove_all(exp_dir / "runs" / r.run_id, ec);
@@ -355,35 +382,60 @@ void execute_in_parallel(const Plan& plan, const std::vector<size_t>& todo, int 
         e.status = "failed";
         set_presentation(e.row, plan, r);
         e.row["status"] = "failed";
-        e.row["notes"] = std::string("failed: ") + ex.what();
+        const bool oom = dynamic_cast<const std::bad_alloc*>(&ex) != nullptr;  // never "std::bad_alloc" alone
+        e.row["notes"] = std::string("failed: ") + (oom ? "out of memory" : ex.what());
         e.record = {{"run_id", r.run_id}, {"error", ex.what()}, {"method", plan.methods[r.method].options}};
       }
       e.shard = opt.shard;
       {
-        std::unique_lock<std::mutex> lk(mu);
-        entries[i] = std::move(e);
-        free_slots += w;
-        ++done;
+        std::unique_lock<std::mutex> lk(s.mu);
+        s.entries[i] = std::move(e);
+        s.free_slots += w;
+        --s.busy;
+        ++s.done;
         if (!opt.quiet) {
           const double el = since(start);
-          const double eta = done < total ? el / done * (total - done) : 0.0;
-          err << "[" << done << "/" << total << "] " << (entries[i].status == "ok" ? "done " : "FAILED ")
+          const double eta = s.done < total ? el / s.done * (total - s.done) : 0.0;
+          err << "[" << s.done << "/" << total << "] " << (s.entries[i].status == "ok" ? "done " : "FAILED ")
               << r.run_id << " in " << std::fixed << std::setprecision(1) << since(t0) << std::defaultfloat
               << " s";
-          if (entries[i].status == "ok") err << ", rel_mse " << entries[i].row["rel_mse"];
-          else err << ": " << entries[i].row["notes"];
+          if (s.entries[i].status == "ok") err << ", rel_mse " << s.entries[i].row["rel_mse"];
+          else err << ": " << s.entries[i].row["notes"];
           err << " | elapsed " << hms(el) << ", eta " << hms(eta) << "\n";
         }
       }
-      cv.notify_all();
+      s.cv.notify_all();
     }
   };
+  PoolEnd end;
+  std::vector<std::thread> pool;
+  const int n_threads = std::min<int>(jobs, static_cast<int>(todo.size()));
+  for (int t = 0; t < n_threads; ++t)
+    pool.emplace_back([st, work] {
+      work(*st);
+      {
+        std::unique_lock<std::mutex> lk(st->mu);
+        ++st->exited;
+      }
+      st->cv.notify_all();
+    });
   {
-    std::vector<std::thread> pool;
-    const int n_threads = std::min<int>(jobs, static_cast<int>(todo.size()));
-    for (int t = 0; t < n_threads; ++t) pool.emplace_back(worker);
-    for (auto& t : pool) t.join();
+    std::unique_lock<std::mutex> lk(st->mu);
+    while (st->exited < n_threads && !interrupt_signal()) st->cv.wait_for(lk, std::chrono::milliseconds(100));
+    end.stopped_by = st->exited < n_threads || st->done < total ? interrupt_signal() : 0;
+    if (end.stopped_by) {
+      st->cv.notify_all();  // idle workers see the signal and return
+      end.abandon = st->busy > 0;
+      if (!end.abandon)
+        while (st->exited < n_threads) st->cv.wait_for(lk, std::chrono::milliseconds(100));
+    }
+    entries = st->entries;  // a snapshot: abandoned workers may still write theirs
   }
+  for (auto& t : pool) {
+    if (end.abandon) t.detach();  // the process ends without returning (run_experiment, _Exit)
+    else t.join();
+  }
+  return end;
 }
 
 enum class Action { Run, Redo, Cached, Forced, OtherShard };
@@ -492,6 +544,13 @@ RunSummary run_experiment(const RunOptions& opt, std::ostream& out, std::ostream
   sum.out_dir = dir;
   sum.planned = plan.runs.size();
   const fs::path exp_dir(dir);
+  // One writer per output folder, held from before the cache is read until the tables are written.
+  std::optional<OutdirLock> lock;
+  std::optional<InterruptScope> interrupt_scope;  // SIGINT/SIGTERM stop cleanly (experiments/interrupt.h)
+  if (!opt.dry_run) {
+    lock.emplace(dir, "run " + opt.config);
+    interrupt_scope.emplace();
+  }
 
   // Decide what each run of this shard needs.
   std::vector<Action> action(plan.runs.size());
@@ -557,7 +616,22 @@ RunSummary run_experiment(const RunOptions& opt, std::ostream& out, std::ostream
     }
   }
   const auto start = Clock::now();
-  execute_in_parallel(plan, todo, jobs, samples, exp_dir, build, opt, err, entries);
+  const PoolEnd pool_end = execute_in_parallel(plan, todo, jobs, samples, exp_dir, build, opt, err, entries);
+  const int stopped_by = pool_end.stopped_by;
+  size_t unfinished = 0;
+  if (stopped_by)
+    for (size_t i : todo)
+      if (entries[i].run_id.empty()) {
+        ++unfinished;
+        RunEntry& e = entries[i];
+        e.run_id = plan.runs[i].run_id;
+        e.status = "interrupted";
+        e.shard = opt.shard;
+        set_presentation(e.row, plan, plan.runs[i]);
+        e.row["status"] = "interrupted";
+        e.row["notes"] = "interrupted by " + signal_name(stopped_by) + " before it finished; the next run does it";
+        e.record = {{"run_id", e.run_id}, {"error", "interrupted"}, {"method", plan.methods[plan.runs[i].method].options}};
+      }
 
   ExperimentOutput o = base_output(plan, dir, opt.shard, opt.shards);
   o.plots = opt.plots && plan.experiment.plots;
@@ -568,7 +642,7 @@ RunSummary run_experiment(const RunOptions& opt, std::ostream& out, std::ostream
       if (action[i] == Action::Cached) ++sum.cached;
       else ++sum.executed;
       if (action[i] == Action::Redo) ++sum.redone;
-    } else {
+    } else if (entries[i].status != "interrupted") {
       ++sum.failed;
     }
     o.runs.push_back(entries[i]);
@@ -577,6 +651,21 @@ RunSummary run_experiment(const RunOptions& opt, std::ostream& out, std::ostream
   if (!opt.quiet)
     err << "experiment " << plan.experiment.name << ": " << sum.executed << " run, " << sum.cached
         << " cached, " << sum.failed << " failed in " << hms(since(start)) << "\n";
+  if (stopped_by) {
+    const std::string msg = "interrupted by " + signal_name(stopped_by) + ": " +
+                            std::to_string(sum.in_shard - unfinished) + " of " + std::to_string(sum.in_shard) +
+                            " runs are finished and written to " + sum.files.results_md + ", " +
+                            std::to_string(unfinished) +
+                            " are not (marked interrupted); run the same command again to resume "
+                            "(finished runs are reused)";
+    if (pool_end.abandon) {  // runs still executing on detached threads: end the process here
+      err << "brdf-factor: " << msg << "\n";
+      err.flush();
+      std::fflush(nullptr);
+      std::_Exit(128 + stopped_by);
+    }
+    throw Interrupted(msg, stopped_by);
+  }
   print_results(out, sum.files);
   if (sum.failed) {
     std::string first;
@@ -661,6 +750,7 @@ RunSummary merge_experiments(const std::vector<std::string>& dirs, const std::st
 
   // Copy the run folders and write the merged folder.
   const fs::path odir(out_dir);
+  const OutdirLock lock(out_dir, "merge");
   fs::create_directories(odir / "runs");
   ExperimentOutput o;
   o.dir = out_dir;

@@ -2,6 +2,11 @@
 // that reads them back (see export.h).
 #include "factor/export.h"
 
+#include "brdfs/temp_file.h"
+
+#include "brdfs/file_check.h"
+#include "brdfs/safe_path.h"
+
 #include <fcntl.h>
 #include <unistd.h>
 
@@ -47,9 +52,7 @@ class AtomicBatch {
   // A fresh temporary path for the final file `name` (in the same folder, so
   // the rename is atomic).
   fs::path add(const std::string& name) {
-    static std::atomic<unsigned> counter{0};
-    const fs::path tmp = dir_ / ("." + name + ".tmp-" + std::to_string(::getpid()) + "-" +
-                                 std::to_string(counter++));
+    const fs::path tmp = create_unique_temp((dir_ / name).string());
     files_.emplace_back(tmp, dir_ / name);
     return tmp;
   }
@@ -249,6 +252,7 @@ class Sidecar {
 
 // Reads a term's EXR into t.texels (planar), checking size, channels and values.
 void read_texture(const std::string& path, const std::string& field, FactorTerm& t) {
+  check_regular_file(path, kMaxImageFileBytes, field);
   const int R = t.proj.res;
   FloatImage img;
   try {
@@ -378,6 +382,7 @@ ExportedFiles write_factorization(const HomomorphicFactorization& f, const std::
 std::shared_ptr<HomomorphicFactorization> load_factorization(const std::string& json_path) {
   json j;
   {
+    check_regular_file(json_path, kMaxTextFileBytes, "factorization sidecar");
     std::ifstream in(json_path, std::ios::binary);
     if (!in) {
       throw std::invalid_argument(json_path + ": cannot open factorization sidecar" +
@@ -420,7 +425,24 @@ std::shared_ptr<HomomorphicFactorization> load_factorization(const std::string& 
 
   const json& tjs = s.member(j, "", "terms", "an array of terms");
   if (!tjs.is_array()) s.fail("terms", "an array of terms", tjs);
+  // Bounded memory: a few bytes of JSON per term could otherwise name one large
+  // texture thousands of times.
+  if (tjs.size() > kMaxSidecarTerms)
+    s.fail_text("terms", "at most " + std::to_string(kMaxSidecarTerms) + " terms",
+                std::to_string(tjs.size()));
   const fs::path folder = fs::path(json_path).parent_path();
+  {  // Counted before any texture is read.
+    uint64_t texels = 0;
+    for (const json& tj : tjs)
+      if (tj.is_object() && tj.contains("resolution") && tj["resolution"].is_number_integer()) {
+        const int64_t r = tj["resolution"].get<int64_t>();
+        if (r >= 2 && r <= 1024) texels += uint64_t(r) * uint64_t(r);
+      }
+    if (texels > kMaxSidecarTexels)
+      s.fail_text("terms", "at most " + std::to_string(kMaxSidecarTexels) + " texels over all terms (" +
+                               std::to_string(kMaxSidecarTexels >> 20) + " Mi, e.g. 64 terms of 1024x1024)",
+                  std::to_string(texels) + " texels");
+  }
   std::vector<FactorTerm> terms;
   for (size_t k = 0; k < tjs.size(); ++k) {
     const std::string where = "terms[" + std::to_string(k) + "]";
@@ -468,6 +490,11 @@ std::shared_ptr<HomomorphicFactorization> load_factorization(const std::string& 
     }
     const std::string tex = s.string(tj, where, "texture");
     if (tex.empty()) s.fail_text(where + ".texture", "a file name", "\"\"");
+    // Decided from the text alone: the message never tells whether a file
+    // outside the sidecar's folder exists.
+    if (!is_path_inside(tex))
+      s.fail_text(where + ".texture",
+                  "a file name inside the sidecar's folder (relative, no '..')", quote_for_message(tex));
     read_texture((folder / tex).string(), where + ".texture", t);
     terms.push_back(std::move(t));
   }
@@ -476,6 +503,7 @@ std::shared_ptr<HomomorphicFactorization> load_factorization(const std::string& 
 
 namespace {
 bool is_model_fit_file(const std::string& path) {
+  check_regular_file(path, kMaxTextFileBytes, "");
   std::ifstream in(path);
   if (!in) return false;
   const nlohmann::json j = nlohmann::json::parse(in, nullptr, false);

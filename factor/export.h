@@ -21,6 +21,7 @@
 //                    texel-coordinate mapping per term (see write_factorization).
 #pragma once
 
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
@@ -70,8 +71,13 @@ ExportedFiles write_factorization(const HomomorphicFactorization& f, const std::
 // and > 0; eps in (0, 1]; quaternion_pair 8 finite numbers if present), and
 // each EXR (size equal to the resolution, 3 channels, finite texels, zero
 // outside the projection mask, mask size equal to mask_texels if given).
+// Texture names must stay inside the sidecar's folder (relative, no '..');
+// at most kMaxSidecarTerms terms and kMaxSidecarTexels texels over all terms;
+// the sidecar and each texture must be regular files (brdfs/file_check.h).
 // Throws std::invalid_argument with a message naming the file, the field, what
 // was expected and what was found.
+inline constexpr size_t kMaxSidecarTerms = 1024;
+inline constexpr uint64_t kMaxSidecarTexels = uint64_t(1) << 26;  // 64 terms of 1024x1024
 std::shared_ptr<HomomorphicFactorization> load_factorization(const std::string& json_path);
 
 // Registers the ".json" loader, so a sidecar path works wherever a BRDF spec is

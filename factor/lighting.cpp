@@ -1,6 +1,7 @@
 // Environment lighting, band limits, lit shading and the SHRM (see lighting.h).
 #include "factor/lighting.h"
 
+#include "brdfs/file_check.h"
 #include "factor/image_io.h"
 
 #include <algorithm>
@@ -30,6 +31,7 @@ Vec3 LatLongMap::direction(int x, int y, int width, int height) {
 }
 
 LatLongMap read_latlong(const std::string& path) {
+  check_regular_file(path, kMaxImageFileBytes, "environment map");
   std::string ext = fs::path(path).extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
   if (ext != ".exr" && ext != ".hdr" && ext != ".pic")

@@ -11,23 +11,36 @@ namespace bf {
 LogTransform LogTransform::of(const SampleSet& s, double eps) {
   if (!(eps > 0.0 && eps <= 1.0))
     throw std::invalid_argument("eps: expected 0 < eps <= 1, found " + std::to_string(eps));
-  Rgb sum = Rgb::Zero();
+  // Summed in long double: values near the top of double's range do not
+  // overflow the sum, and the messages below can tell overflow, underflow and
+  // an all-zero channel apart.
+  long double sum[3] = {0, 0, 0};
+  bool nonzero[3] = {false, false, false};
   size_t n = 0;
   for (size_t k = 0; k < s.size(); ++k)
     if (s.valid[k]) {
-      sum += s.value[k];
+      for (int c = 0; c < 3; ++c) {
+        sum[c] += s.value[k][c];
+        nonzero[c] = nonzero[c] || s.value[k][c] != 0.0;
+      }
       ++n;
     }
   if (n == 0) throw std::invalid_argument("log transform: the sample set has no valid sample");
   LogTransform t;
-  t.A = sum / double(n);
   t.eps = eps;
-  for (int c = 0; c < 3; ++c)
-    if (!(t.A[c] > 0.0) || !std::isfinite(t.A[c]))
-      throw std::invalid_argument("log transform: channel " + std::string(1, "rgb"[c]) +
-                                  " has mean " + std::to_string(t.A[c]) +
-                                  " over the valid samples (an all-zero BRDF cannot be "
-                                  "factored in log space)");
+  for (int c = 0; c < 3; ++c) {
+    const long double mean = sum[c] / static_cast<long double>(n);
+    const std::string head = "log transform: channel " + std::string(1, "rgb"[c]) + " ";
+    if (!nonzero[c])
+      throw std::invalid_argument(head + "has mean 0: it is 0 at every valid sample (an all-zero BRDF "
+                                  "cannot be factored in log space)");
+    if (!(mean <= static_cast<long double>(std::numeric_limits<double>::max())))
+      throw std::invalid_argument(head + "has a mean beyond the double range (values up to about 1.8e308 "
+                                  "are representable, their mean must be too)");
+    t.A[c] = static_cast<double>(mean);  // denormal means stay (tested by the stress case "denormal")
+    if (!(t.A[c] > 0.0))
+      throw std::invalid_argument(head + "has a mean below the smallest double (underflow: rescale the BRDF)");
+  }
   t.eps = eps;
   return t;
 }

@@ -1,6 +1,10 @@
 // Analytic model fits with Ceres (see model_fit.h).
 #include "factor/model_fit.h"
 
+#include "brdfs/temp_file.h"
+
+#include "brdfs/file_check.h"
+
 #include <ceres/ceres.h>
 
 #include <Eigen/Dense>
@@ -581,10 +585,7 @@ void write_model_fit(const ModelFitResult& r, const std::string& path) {
   j["format_version"] = 1;
   namespace fs = std::filesystem;
   const fs::path target(path);
-  std::string tmp_name = ".";
-  tmp_name += target.filename().string();
-  tmp_name += ".tmp";
-  const fs::path tmp = target.parent_path() / tmp_name;
+  const fs::path tmp = create_unique_temp(path);
   {
     std::ofstream o(tmp);
     if (!o) throw std::runtime_error(tmp.string() + ": cannot write");
@@ -600,6 +601,7 @@ void write_model_fit(const ModelFitResult& r, const std::string& path) {
 }
 
 BrdfPtr load_model_fit(const std::string& path) {
+  check_regular_file(path, kMaxTextFileBytes, "model fit");
   std::ifstream in(path);
   if (!in) throw std::invalid_argument(path + ": cannot open");
   nlohmann::json j;

@@ -153,10 +153,11 @@ SvdTable tabulate_svd(const Brdf& brdf, const SvdOptions& opt) {
     if (count == 0) throw std::invalid_argument("svd: no tabulated pair lies in the domain");
     t.A = sum / count;
     for (int ch = 0; ch < 3; ++ch) {
-      if (!(t.A[ch] > 0.0))
+      if (!(t.A[ch] > 0.0) || !std::isfinite(t.A[ch]))
         throw std::invalid_argument("svd: log = true but channel " + std::string(1, "rgb"[ch]) +
-                                    " of " + brdf.to_string() +
-                                    " has mean 0 (an all-zero BRDF has no log)");
+                                    " of " + brdf.to_string() + " has mean " + std::to_string(t.A[ch]) +
+                                    (t.A[ch] == 0.0 ? " (an all-zero BRDF has no log)"
+                                                    : " (outside the double range: rescale the BRDF)"));
       const double A = t.A[ch], bias = opt.eps * A;
       t.M[ch] = ((t.M[ch].array() + bias) / A).log().matrix();
     }

@@ -57,8 +57,19 @@ void SearchOptions::validate() const {
   if (search_texture_size != 0 && (search_texture_size < 2 || search_texture_size > 1024))
     throw OptionError("search_texture_size", "search_texture_size: expected 0 (same as texture_size) or "
                                 "2..1024, found " + std::to_string(search_texture_size));
-  if (restarts < 0)
-    throw OptionError("restarts", "restarts: expected >= 0, found " + std::to_string(restarts));
+  if (terms > kMaxSearchTerms)
+    throw OptionError("terms", "terms: expected 1.." + std::to_string(kMaxSearchTerms) + ", found " +
+                                std::to_string(terms));
+  if (uint64_t(terms) * uint64_t(texture_size) * uint64_t(texture_size) > kMaxTotalTexels)
+    throw OptionError("terms", "terms x texture_size^2: expected at most " + std::to_string(kMaxTotalTexels) +
+                                " texels (e.g. 64 terms of 1024x1024), found " + std::to_string(terms) + " x " +
+                                std::to_string(texture_size) + "^2");
+  if (restarts < 0 || restarts > kMaxRestarts)
+    throw OptionError("restarts", "restarts: expected 0.." + std::to_string(kMaxRestarts) + ", found " +
+                                std::to_string(restarts));
+  if (backfit_restarts > kMaxRestarts)
+    throw OptionError("backfit_restarts", "backfit_restarts: expected 0.." + std::to_string(kMaxRestarts) + ", found " +
+                                std::to_string(backfit_restarts));
   for (const auto& g : guesses) guess_rotation(g);  // throws for unknown names
   if (strategy == "greedy" && restarts == 0 && guesses.empty())
     throw OptionError("restarts", "restarts: 0 restarts and no guesses leave nothing to search from");

@@ -19,6 +19,7 @@
 //    objective.
 #pragma once
 
+#include <cstdint>
 #include <functional>
 #include <memory>
 #include <string>
@@ -28,6 +29,11 @@
 #include "search/powell.h"
 
 namespace bf {
+
+// Bounds that keep memory and time finite for any options (docs/robustness.md).
+inline constexpr int kMaxSearchTerms = 64;
+inline constexpr int kMaxRestarts = 100000;
+inline constexpr uint64_t kMaxTotalTexels = uint64_t(1) << 26;  // terms x texture_size^2
 
 struct SearchOptions {
   // "structured" (structured_search.h: seeds read off the data's Hessians,

@@ -1,0 +1,55 @@
+// Signal handling for `run` (see interrupt.h).
+#include "experiments/interrupt.h"
+
+#include <signal.h>
+#include <unistd.h>
+
+#include <atomic>
+
+namespace bf {
+
+namespace {
+
+std::atomic<int> g_signal{0};
+struct sigaction g_old_int, g_old_term;
+
+extern "C" void on_signal(int sig) {
+  int expected = 0;
+  if (g_signal.compare_exchange_strong(expected, sig)) {
+    static const char msg[] =
+        "brdf-factor: interrupted: no new run starts; writing the finished runs (signal again to stop at once)\n";
+    const ssize_t w = ::write(STDERR_FILENO, msg, sizeof msg - 1);
+    (void)w;
+    return;
+  }
+  // Second signal: the default action, now.
+  ::signal(sig, SIG_DFL);
+  ::raise(sig);
+}
+
+}  // namespace
+
+InterruptScope::InterruptScope() {
+  g_signal = 0;
+  struct sigaction sa {};
+  sa.sa_handler = on_signal;
+  sigemptyset(&sa.sa_mask);
+  sa.sa_flags = SA_RESTART;
+  ::sigaction(SIGINT, &sa, &g_old_int);
+  ::sigaction(SIGTERM, &sa, &g_old_term);
+}
+
+InterruptScope::~InterruptScope() {
+  ::sigaction(SIGINT, &g_old_int, nullptr);
+  ::sigaction(SIGTERM, &g_old_term, nullptr);
+}
+
+int interrupt_signal() { return g_signal.load(); }
+
+std::string signal_name(int sig) {
+  if (sig == SIGINT) return "SIGINT";
+  if (sig == SIGTERM) return "SIGTERM";
+  return "signal " + std::to_string(sig);
+}
+
+}  // namespace bf

@@ -1,0 +1,38 @@
+// SIGINT / SIGTERM during `run` (docs/robustness.md): the first signal asks the
+// runner to stop cleanly (no new run starts, the tables of the finished runs
+// are written, a message says how to resume, exit 128 + signal); a second one
+// kills the process at once (the default action).
+#pragma once
+
+#include <stdexcept>
+#include <string>
+
+namespace bf {
+
+// Installs the handlers for its lifetime (restoring the previous ones after).
+class InterruptScope {
+ public:
+  InterruptScope();
+  ~InterruptScope();
+  InterruptScope(const InterruptScope&) = delete;
+  InterruptScope& operator=(const InterruptScope&) = delete;
+};
+
+// The signal received since the scope was entered (SIGINT, SIGTERM), or 0.
+int interrupt_signal();
+
+// "SIGINT", "SIGTERM" or "signal N".
+std::string signal_name(int sig);
+
+// Thrown by the runner after it stopped cleanly on a signal; main exits with
+// 128 + signal.
+class Interrupted : public std::runtime_error {
+ public:
+  Interrupted(const std::string& what, int sig) : std::runtime_error(what), signal_(sig) {}
+  int signal() const { return signal_; }
+
+ private:
+  int signal_;
+};
+
+}  // namespace bf
