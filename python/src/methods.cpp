@@ -352,6 +352,14 @@ std::shared_ptr<PyFactorization> run_fit(const SampleSet& s, const py::kwargs& k
 std::shared_ptr<PyFactorization> run_search(const SampleSet& s, const py::kwargs& kw) {
   Options o("search", kw);
   SearchOptions so;
+  // As in configs: Cole's greedy search unless strategy = "structured".
+  so.strategy = o.choice("strategy", "greedy", {"greedy", "structured"});
+  so.term_param = o.choice("term_param", so.term_param, {"either", "fixed"});
+  so.keep = o.integer("keep", so.keep, 1, 1000);
+  so.polish_sweeps = o.integer("polish_sweeps", so.polish_sweeps, 0, 1000);
+  so.beam_width = o.integer("beam_width", so.beam_width, 1, 1000);
+  so.final_joint = o.boolean("final_joint", so.final_joint);
+  so.joint_polish_terms = o.integer("joint_polish_terms", so.joint_polish_terms, 0, 64);
   so.param = read_param(o, so.param);
   const std::optional<Tolerance> tol = read_tolerance(o);
   so.terms = o.integer("terms", tol ? 8 : so.terms, 1, 64);
@@ -636,8 +644,10 @@ reciprocity, tolerance, the fit options and refinement of mccool().)doc");
   m.def("search", &run_search, py::arg("samples"),
         R"doc(search(samples, **options) -> Factorization
 
-Cole's automatic factorization (Powell search over 4D rotations). Options as
-kind = "search": terms, parameterization, texture_size, search_texture_size,
+Cole's automatic factorization (Powell search over 4D rotations); with
+strategy="structured" the search of docs/search.md. Options as kind =
+"search": strategy, term_param, keep, polish_sweeps, beam_width, final_joint,
+joint_polish_terms, terms, parameterization, texture_size, search_texture_size,
 restarts, guesses, reciprocity, optimizer, ftol, line_tol, initial_step,
 max_sweeps, max_evaluations, threads, seed, beam, backfit_sweeps,
 backfit_restarts, tolerance, the fit options and refinement of mccool().
