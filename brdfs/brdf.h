@@ -1,7 +1,7 @@
 // The BRDF interface every analytic and measured model implements, and the
 // frame conventions they all share.
 //
-// Conventions (DESIGN.md §2), stated once here:
+// Conventions (docs/design.md §2), stated once here:
 //  - Local shading frame: normal n = +z, tangent t = +x, bitangent = +y.
 //  - wi points towards the light, wo towards the viewer, both away from the
 //    surface, both unit length.

@@ -1,5 +1,5 @@
 // Direction maps: spherical angles, the Heidrich-Seidel parabolic map, and the
-// two 4D parameterizations of (wi, wo) the fitter works in (DESIGN.md §2).
+// two 4D parameterizations of (wi, wo) the fitter works in (docs/design.md §2).
 #pragma once
 
 #include <string>

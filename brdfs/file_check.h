@@ -1,4 +1,4 @@
-// Input files are regular files of bounded size (DESIGN.md §7,
+// Input files are regular files of bounded size (docs/design.md §7,
 // docs/robustness.md): a FIFO, device (/dev/zero), directory or socket given
 // where a data file is expected is refused before any reader opens it, so
 // nothing blocks on a pipe or reads an endless device.

@@ -1,4 +1,4 @@
-// Names read from files become paths only after these checks (DESIGN.md §7,
+// Names read from files become paths only after these checks (docs/design.md §7,
 // docs/robustness.md): a run id or experiment name is one plain folder name,
 // a file a sidecar or record refers to stays inside its folder.
 #pragma once

@@ -1,4 +1,4 @@
-// Sample-list CSV (DESIGN.md §5), input and output:
+// Sample-list CSV (docs/design.md §5), input and output:
 //   header  theta_i,phi_i,theta_o,phi_o,r,g,b[,weight]
 //   angles in radians (frame of brdf.h), values in 1/sr; lines whose first
 //   non-blank character is '#' are comments; blank lines are skipped; CRLF and

@@ -1,4 +1,4 @@
-// Subcommand `bench fit`: times the inner-loop fit (DESIGN.md §5) and prints
+// Subcommand `bench fit`: times the inner-loop fit (docs/design.md §5) and prints
 // one JSON object per line.
 #include <algorithm>
 #include <chrono>

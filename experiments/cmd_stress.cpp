@@ -132,7 +132,7 @@ int run(const StressArgs& a) {
 void add_cmd_stress(CLI::App& app) {
   auto a = std::make_shared<StressArgs>();
   CLI::App* c = app.add_subcommand(
-      "stress", "Run the stress matrix (hard cases x methods, DESIGN.md §7); exit 1 if an expectation fails");
+      "stress", "Run the stress matrix (hard cases x methods, docs/design.md §7); exit 1 if an expectation fails");
   c->add_option("--out", a->out, "CSV with one row per case and method");
   c->add_option("--config", a->config,
                 "TOML case list ([[case]] name, expect, expect_<method>); default: every built-in case");

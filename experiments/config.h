@@ -1,4 +1,4 @@
-// Experiment configs (DESIGN.md §5, docs/experiments.md): TOML parsing, `-D`
+// Experiment configs (docs/design.md §5, docs/experiments.md): TOML parsing, `-D`
 // overrides, validation that names file:line, field and rule for every problem
 // before any work starts, and sweep expansion into a plan of runs, each with a
 // content-hash run id.
@@ -48,11 +48,11 @@ struct ExperimentSettings {
   bool plots = true;        // call experiments/plot_results.py after the runs
   bool render = true;       // per run: sphere picture (original | approximation | error)
   bool export_factors = true;  // per run: factor textures, sidecar, GLSL (config key `export`)
-  double metric_eps = 1e-5; // eps of the log transform every method is scored with (DESIGN.md §4)
+  double metric_eps = 1e-5; // eps of the log transform every method is scored with (docs/design.md §4)
 };
 
 // [scene]: the picture of every run; when the table is present, also the
-// shade_rmse column (DESIGN.md §4). A unit sphere at the origin seen by an
+// shade_rmse column (docs/design.md §4). A unit sphere at the origin seen by an
 // orthographic camera on +z, lit by one point light, or by band-limited SH
 // lighting (factor/lighting.h) when `environment` or `lighting_order` is set;
 // the SH lighting's order then caps the orders of sh-k and sh-r.

@@ -275,7 +275,7 @@ void write_results_md(const ExperimentOutput& e, const OutputFiles& f, const std
     if (!e.merged_from.empty()) o << " (merged from " << e.merged_from.size() << " shard folders)";
     if (failed) o << ", **" << failed << " failed**";
     o << "\n- seed: " << x.value("seed", json(1)).dump() << " (per-run seeds in manifest.json)\n";
-    o << "- errors: DESIGN.md §4 on each run's samples (log transform eps "
+    o << "- errors: docs/design.md §4 on each run's samples (log transform eps "
       << x.value("metric_eps", json(1e-5)).dump() << "); `seconds` is the method's wall time\n";
     o << "- files: [results.csv](results.csv) (full precision and extra columns), "
          "[manifest.json](manifest.json), [report.html](report.html)\n\n";

@@ -1,4 +1,4 @@
-// An experiment folder's tables and records (DESIGN.md §5): results.csv,
+// An experiment folder's tables and records (docs/design.md §5): results.csv,
 // results.md, manifest.json, the config copy, the plots (through
 // experiments/plot_results.py) and report.html, all written atomically. Used
 // by `run` (one folder per experiment or shard) and by `merge`.
@@ -17,7 +17,7 @@ inline constexpr int kExperimentFormatVersion = 1;
 inline constexpr const char* kExperimentFormat = "brdf-factor-experiment";
 inline constexpr const char* kBrdfFactorVersion = "0.1.0";
 
-// results.csv columns: DESIGN.md §5's, exactly and in that order...
+// results.csv columns: docs/design.md §5's, exactly and in that order...
 const std::vector<std::string>& required_columns();
 // ...then the extras: label, sampling, sweep, seed, status, errors_after_term,
 // negative_texels, order, view_order, tolerance, tolerance_reached,

@@ -1,6 +1,6 @@
 // The per-run picture (like the thesis's Figures 4.1 and 4.4): a sphere lit by
 // one point light, rendered with the original BRDF, with the approximation, and
-// an error heat map, side by side; and shade_rmse (DESIGN.md §4) from the same
+// an error heat map, side by side; and shade_rmse (docs/design.md §4) from the same
 // two renders.
 #pragma once
 

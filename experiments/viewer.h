@@ -12,7 +12,7 @@
 //              kViewerIsoThetaH) or {kind: "wiwo", res: R, data}: R^2 x R^2
 //              texels, pixel (x, y) = (texel of p(wo), texel of p(wi)), texel
 //              index j*R + i at p = (-1 + 2i/(R-1), -1 + 2j/(R-1)) pulled in
-//              to radius 1 - 1/(R-1) (DESIGN.md §3.6),
+//              to radius 1 - 1/(R-1) (docs/design.md §3.6),
 //   scene:     {light: [x, y, z], intensity, size}, exposure: 1 / the 99th
 //              percentile of the original render's brightest channel
 //              (sphere.png's exposure) }.

@@ -95,7 +95,7 @@ vec3 bf_eval(vec3 wi, vec3 wo) {
 
 void main() {
   vec2 f = gl_FragCoord.xy;
-  // Pixel (x, y), y = 0 at the top, as the CPU render (DESIGN.md 5.4).
+  // Pixel (x, y), y = 0 at the top, as the CPU render (docs/design.md §5.4).
   float px = -1.0 + 2.0 * f.x / u_size.x;
   float py = 1.0 - 2.0 * (u_size.y - f.y) / u_size.y;
   if (u_mode == 0) {

@@ -593,7 +593,7 @@ BaselineExportFiles write_baseline_export(const Factorization& f, const std::str
     images.emplace_back(stem + "_cols.exr", std::move(cols));
     j["texel_mapping"] =
         "s_row = (x[0..1] + 1) / 2 * (resolution - 1), s_col = (x[2..3] + 1) / 2 * (resolution - 1), x = "
-        "(p(wi), p(wo)) or (p(h), p(d)); bilinear as DESIGN.md 2.6";
+        "(p(wi), p(wo)) or (p(h), p(d)); bilinear as docs/design.md §2.6";
   } else if (auto s = dynamic_cast<const ShkFactorization*>(&f)) {
     FloatImage img;
     shk_data(*s, d, img);

@@ -1,4 +1,4 @@
-// Export of the SVD, SH-K and SH-R baselines (DESIGN.md §5.8): what a renderer
+// Export of the SVD, SH-K and SH-R baselines (docs/design.md §5.8): what a renderer
 // needs to evaluate them, and what `--brdf STEM.json` reloads so that it
 // evaluates exactly as the factorization that was written.
 //

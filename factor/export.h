@@ -1,4 +1,4 @@
-// Factor export (DESIGN.md §5): a HomomorphicFactorization written as float
+// Factor export (docs/design.md §5): a HomomorphicFactorization written as float
 // EXR textures, PNG previews, a JSON sidecar and a generated GLSL function, and
 // read back from the sidecar so that the reloaded factorization evaluates
 // bit-identically to the one that was written.

@@ -1,12 +1,12 @@
 // Generated GLSL that evaluates a HomomorphicFactorization on the GPU from its
-// exported textures (DESIGN.md §5 "Factor export").
+// exported textures (docs/design.md §5 "Factor export").
 //
 // The generated code defines
 //   uniform sampler2D brdf_factor_texK;            one per term K
 //   vec3 brdf_factor_eval(vec3 wi, vec3 wo);       RGB in 1/sr, no cosine
 // plus helpers prefixed brdf_factor_. It has no #version line so it can be
 // pasted or included into a shader; it needs GLSL 3.30 (#version 330 core) or
-// later. wi, wo: unit vectors in the local frame of DESIGN.md §2 (n = +z,
+// later. wi, wo: unit vectors in the local frame of docs/design.md §2 (n = +z,
 // t = +x), wi towards the light, wo towards the viewer; 0 below the horizon.
 //
 // Per term it computes the parabolic point x of (wi, wo) in the term's

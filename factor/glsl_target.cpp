@@ -29,7 +29,7 @@ const char* glsl_point_helpers() {
   return R"(// Heidrich-Seidel parabolic map of the upper hemisphere onto the unit disk.
 vec2 brdf_factor_parabolic(vec3 w) { return w.xy / (1.0 + w.z); }
 
-// x = (p(h), p(d)) of the halfdiff parameterization (DESIGN.md 2.3):
+// x = (p(h), p(d)) of the halfdiff parameterization (docs/design.md §2.3):
 // h = normalize(wi + wo) (n if wi = -wo); frame r = normalize(t - (t.h) h) with
 // t = +x, or t = +y when that is shorter than 1e-12; s = h x r;
 // d = (wi.r, wi.s, wi.h), except for |wi + wo| < 1 where d.z = |wi + wo| / 2

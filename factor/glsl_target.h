@@ -1,5 +1,5 @@
 // What makes generated GLSL compile unchanged for every target a renderer
-// uses (DESIGN.md §5.7): OpenGL 3.3 core and 4.5, OpenGL ES 3.0 and Vulkan
+// uses (docs/design.md §5.7): OpenGL 3.3 core and 4.5, OpenGL ES 3.0 and Vulkan
 // (glslangValidator -V, which defines VULKAN). Shared by the homomorphic
 // export (factor/glsl.cpp) and the SVD / SH exports (factor/baseline_export.cpp).
 #pragma once
@@ -21,7 +21,7 @@ std::string glsl_target_prelude();
 std::string glsl_sampler_decl(const std::string& name, int binding);
 
 // GLSL helpers shared by the SVD and SH exports: brdf_factor_parabolic(vec3)
-// and brdf_factor_halfdiff(vec3 wi, vec3 wo) (the x = (p(h), p(d)) of DESIGN.md
+// and brdf_factor_halfdiff(vec3 wi, vec3 wo) (the x = (p(h), p(d)) of docs/design.md
 // §2.3, grazing branch and t = +y fallback included). The homomorphic export
 // has its own copy in factor/glsl.cpp (same text).
 const char* glsl_point_helpers();

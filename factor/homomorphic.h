@@ -2,7 +2,7 @@
 //   f(wi, wo) ~= A * exp( sum_j  t_j(pi_j(x)) [+ t_j(pi_j*(x)) if reciprocal] )  [- eps*A]
 // per RGB channel, with x the point of (wi, wo) in the term's parameterization,
 // t_j the term's log-space texture read with bilinear interpolation, and A the
-// per-channel mean of f over the fitted samples (DESIGN.md §2).
+// per-channel mean of f over the fitted samples (docs/design.md §2).
 #pragma once
 
 #include <array>

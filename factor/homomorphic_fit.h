@@ -39,13 +39,13 @@
 namespace bf {
 
 struct FitOptions {
-  double eps = 1e-5;         // log-transform epsilon (DESIGN.md §2), 0 < eps <= 1
+  double eps = 1e-5;         // log-transform epsilon (docs/design.md §2), 0 < eps <= 1
   double smoothing = 1e-3;   // Laplacian weight relative to the mean sample weight per texel, >= 0
   bool subtract_eps = true;  // reconstruct A exp(s) - eps A (clamped at 0) instead of A exp(s)
   int solve_last = 2;        // n: the last n terms are solved jointly, >= 1
   // Dense: normal matrix assembled densely, LLT. Sparse: B assembled sparse,
   // B^T W B by sparse product, SimplicialLLT (AMD ordering). Auto: dense up to
-  // 2500 unknowns, sparse above (measured crossover, README). ReferenceQR: the
+  // 2500 unknowns, sparse above (measured crossover, docs/results.md §2). ReferenceQR: the
   // simple path (dense B, Householder QR, no normal equations) for tests.
   enum class Solver { Auto, Dense, Sparse, ReferenceQR } solver = Solver::Auto;
   // Throws std::invalid_argument naming the field, its value and the rule.

@@ -1,5 +1,5 @@
 // Scene lighting for the SH baselines (issue #7 part B; notes
-// ../shared/papers/NOTES-sh-baselines-and-order-selection.md §2.1-2.2, §1.3.5):
+// docs/design.md §9.4-9.5):
 //  - lat-long environment maps (.exr, or Radiance .hdr / .pic),
 //    projected onto real SH (solvers/sh.h convention) with exact quadrature
 //    weights for the equiangular grid;
@@ -10,7 +10,7 @@
 //  - the SHRM of Ramamoorthi & Hanrahan 2002 (reflected-radiance coefficients
 //    B_lmpq = Lambda_l rho_lpq L_lm) and its evaluation B(alpha, beta, theta_o, phi_o).
 //
-// Lat-long convention (DESIGN.md §2 angles, world frame): pixel (x, y) of a
+// Lat-long convention (docs/design.md §2 angles, world frame): pixel (x, y) of a
 // W x H map, W = 2H, row y = 0 at the top, holds the radiance in direction
 // theta = pi (y + 1/2) / H from +z, phi = 2 pi (x + 1/2) / W from +x towards
 // +y: w = (sin theta cos phi, sin theta sin phi, cos theta). Texel values are

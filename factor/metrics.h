@@ -1,4 +1,4 @@
-// Error metrics of DESIGN.md §4: one definition, used by every method, on the
+// Error metrics of docs/design.md §4: one definition, used by every method, on the
 // same samples, so numbers in one table are comparable.
 #pragma once
 

@@ -27,13 +27,13 @@
 //  - "cosine": Ngan, Matusik and Durand 2005's fitting error, the weighted L2
 //    distance of the cosine-weighted BRDFs:
 //      r_kc = sqrt(w_k / 3W) (f_model - f) cos(theta_i) / Abar,
-//    so 2 * cost = cos_rmse^2 / Abar^2 (DESIGN.md §4).
+//    so 2 * cost = cos_rmse^2 / Abar^2 (docs/design.md §4).
 //    cube_root = true compresses the dynamic range first:
 //      r_kc = sqrt(w_k / 3W) (cbrt(f_model cos theta_i) - cbrt(f cos theta_i)) / cbrt(Abar).
 //    Which of the two Ngan et al. used for their published tables is not
 //    verified here (their paper is not in papers/); "cosine" without the cube
 //    root is the default and the metric our cos_rmse column reports.
-//  - "log": the homomorphic transform of DESIGN.md §2,
+//  - "log": the homomorphic transform of docs/design.md §2,
 //      r_kc = sqrt(w_k / 3W) (log((f_model + eps A_c) / A_c) - g_kc),
 //      g_kc = log((f + eps A_c) / A_c),
 //    so 2 * cost = rel_mse, the metric the factorizations minimize.

@@ -24,7 +24,7 @@ struct Projection {
   Mat24 P = Mat24::Zero();  // rows orthonormal (not checked here; see validate())
   int res = 16;             // texture is res x res
 
-  // Conjugate projection of DESIGN.md §2: wiwo swaps column pairs, halfdiff
+  // Conjugate projection of docs/design.md §2: wiwo swaps column pairs, halfdiff
   // negates the d columns. pi*(wi, wo) = pi(wo, wi).
   Projection conjugate() const;
   // Whether conjugate() equals this projection to 1e-12.

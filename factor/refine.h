@@ -18,7 +18,7 @@
 // objective):
 //  - "linear": r_kc = sqrt(w_k / 3W) (F_c(k) - f_c(k)) / Abar.
 //    2 * cost = lin_rmse^2 / Abar^2 (unclamped) + smoothing: its minimizer is
-//    that of lin_rmse (DESIGN.md §4) plus the smoothing term.
+//    that of lin_rmse (docs/design.md §4) plus the smoothing term.
 //  - "cosine": r_kc = sqrt(w_k / 3W) (F_c(k) - f_c(k)) cos(theta_i) / Abar:
 //    the product function shading integrates (cos_rmse).
 //  - "blend" (thesis 3.1.4: a mixture of relative and absolute error), two

@@ -1,5 +1,4 @@
-// Spherical-harmonic baselines (DESIGN.md §9; notes
-// ../shared/papers/NOTES-sh-baselines-and-order-selection.md):
+// Spherical-harmonic baselines (docs/design.md §9):
 //  - SH-K (Kautz, Sloan & Snyder 2002): per view direction v on a parabolic
 //    grid, the SH coefficients of the product function f*(s, v) = f(s, v) max(0, s.z),
 //    any BRDF including anisotropic and measured ones;

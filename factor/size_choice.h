@@ -1,4 +1,4 @@
-// The types of tolerance-driven size selection (DESIGN.md §9 "what a scene
+// The types of tolerance-driven size selection (docs/design.md §9 "what a scene
 // needs"), shared by the SVD and SH baselines (factor/svd_baseline.h,
 // factor/sh_baseline.h), the homomorphic fits (factor/size_select.h) and the
 // search's stopping rule: an error target, the candidates scored, the choice.

@@ -1,6 +1,6 @@
 // Homomorphic fits (McCool's fixed projections, configured projections) sized
 // by one tolerance: the smallest texture resolution of a ladder, with the
-// smallest number of terms there, whose fit reaches an error target (DESIGN.md
+// smallest number of terms there, whose fit reaches an error target (docs/design.md
 // §9; the SVD counterpart is select_svd_size in factor/svd_baseline.h).
 #pragma once
 

@@ -1,4 +1,4 @@
-// The stress matrix (DESIGN.md §7): hard cases (near-delta peaks, grazing-only
+// The stress matrix (docs/design.md §7): hard cases (near-delta peaks, grazing-only
 // samples, zeros, huge dynamic range, n = h, few samples, duplicates, untouched
 // texels, thin projected data, rotated anisotropy, float extremes) run through
 // the factorization methods, each result checked against the expectation

@@ -3,7 +3,7 @@
 // RGB channel (optionally in McCool's log space), evaluated anywhere by
 // bilinear lookups of the factor textures. Also the pieces the SH baselines
 // share: the parabolic texel grid and tolerance-driven selection of a size
-// knob (rank, order) with its time and error (DESIGN.md §6, §9).
+// knob (rank, order) with its time and error (docs/design.md §6, §9).
 #pragma once
 
 #include <Eigen/Core>
@@ -51,12 +51,12 @@ struct DiskGrid {
 
 struct SvdOptions {
   // Rows = first half of the 4D point, columns = second half: (p(wi), p(wo))
-  // for wiwo, (p(h), p(d)) for halfdiff (DESIGN.md §2).
+  // for wiwo, (p(h), p(d)) for halfdiff (docs/design.md §2).
   Parameterization param = Parameterization::WiWo;
   int res = 32;             // texture_size: res x res grid for rows and for columns, 2..256
   int rank = 1;             // terms K >= 1 (capped at the number of masked texels)
   bool log = false;         // decompose g = log((f + eps A)/A) instead of f
-  double eps = 1e-5;        // log-space bias (DESIGN.md §2), 0 < eps <= 1
+  double eps = 1e-5;        // log-space bias (docs/design.md §2), 0 < eps <= 1
   bool subtract_eps = false;  // log reconstruction A exp(.) - eps A (else A exp(.)); Cole omits it
   // DiskGrid: texels beyond radius 1 - rim_inset are evaluated at that radius.
   // 0 (default) = half the grid spacing, 1/(res-1): the rim texel takes the

@@ -34,7 +34,7 @@ max_len_of() {  # the largest input per target
 run_one() {  # run_one TARGET: fuzz it for $seconds, report, return libFuzzer's status
   local t="$1"
   mkdir -p "$build/corpus/$t" "$here/corpus/$t"
-  # -rss_limit_mb: a reader must not allocate without bound (DESIGN.md §7).
+  # -rss_limit_mb: a reader must not allocate without bound (docs/design.md §7).
   if "$build/fuzz/fuzz_$t" "$build/corpus/$t" "$here/corpus/$t" -max_total_time="$seconds" \
       -timeout=10 -rss_limit_mb=2048 -max_len="$(max_len_of "$t")" -print_final_stats=1 \
       -artifact_prefix="$here/corpus/$t/" >"$build/logs/$t.log" 2>&1; then

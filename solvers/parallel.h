@@ -1,4 +1,4 @@
-// A minimal fork-join loop over an index range on all cores (DESIGN.md §6:
+// A minimal fork-join loop over an index range on all cores (docs/design.md §6:
 // "inside one process, use all cores"), for embarrassingly parallel loops such
 // as tabulating a BRDF. No pool is kept between calls.
 #pragma once

@@ -1,6 +1,6 @@
 // Gauss-Legendre quadrature (nodes by Newton's method on P_n) and the product
 // rules on the sphere built from it: Gauss-Legendre in z = cos(theta) times a
-// uniform rule in phi. Exact for band-limited integrands (DESIGN.md §9); a
+// uniform rule in phi. Exact for band-limited integrands (docs/design.md §9); a
 // sin(theta)-weighted midpoint rule converges only as N^-2 (notes P9).
 #pragma once
 

@@ -2,7 +2,7 @@
 // functions, evaluated with the stable three-term recurrences in double
 // precision (accurate to l = 60 and well beyond; no factorials, no overflow).
 //
-// Conventions (DESIGN.md §9), fixed for the whole toolkit:
+// Conventions (docs/design.md §9), fixed for the whole toolkit:
 //  - Order F is a band limit: l = 0..F, (F+1)^2 coefficients. Kautz et al.'s
 //    "fifth order, 25 coefficients" is F = 4 here.
 //  - Flat index i = l*(l+1) + m, m = -l..l.
@@ -13,7 +13,7 @@
 //      p_lm = a_lm (x p_{l-1,m} - b_lm p_{l-2,m}),
 //      a_lm = sqrt((4l^2-1)/(l^2-m^2)),  b_lm = sqrt(((l-1)^2-m^2)/(4(l-1)^2-1)).
 //    (p_lm equals the papers' f_lm = N_lm P_lm(cos theta) up to the sign (-1)^m.)
-//  - Real SH, theta from +z, phi from +x towards +y (DESIGN.md §2):
+//  - Real SH, theta from +z, phi from +x towards +y (docs/design.md §2):
 //      y_{l,0}  = p_l0(cos theta)
 //      y_{l,m}  = sqrt(2) p_lm(cos theta) cos(m phi)   (m > 0)
 //      y_{l,-m} = sqrt(2) p_lm(cos theta) sin(m phi)   (m > 0)

@@ -16,7 +16,7 @@ using nlohmann::json;
 std::vector<KeySpec> fit_keys(const KeySpec& texture_size) {
   return {texture_size,
           num_key("smoothing", 0.0, kInf, false, "1e-3", "Laplacian weight relative to the mean sample weight per texel"),
-          num_key("eps", 0.0, 1.0, true, "1e-5", "log-transform eps of the fit (DESIGN.md §2)"),
+          num_key("eps", 0.0, 1.0, true, "1e-5", "log-transform eps of the fit (docs/design.md §2)"),
           bool_key("subtract_eps", "true",
                    "reconstruct A·exp(s) − eps·A (clamped at 0) instead of A·exp(s); run.json says which"),
           int_key("solve_last", 1, 64, "2", "n: the last n terms are solved jointly (thesis 3.2.2)"),

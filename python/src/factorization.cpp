@@ -68,7 +68,7 @@ and exports.)doc")
             return metrics_dict(mt);
           },
           py::arg("samples"), py::arg("metric_eps") = 1e-5,
-          "Metrics (DESIGN.md §4) of this approximation on any sample set.")
+          "Metrics (docs/design.md §4) of this approximation on any sample set.")
       .def(
           "textures",
           [](const PyFactorization& f) {
@@ -144,7 +144,7 @@ load(sidecar) reads it back (bit-identical evaluation).)doc")
         return metrics_dict(mt);
       },
       py::arg("approx"), py::arg("samples"), py::arg("metric_eps") = 1e-5,
-      "Metrics (DESIGN.md §4) of any BRDF (a factorization, a model, a reloaded export) on a sample set.");
+      "Metrics (docs/design.md §4) of any BRDF (a factorization, a model, a reloaded export) on a sample set.");
   m.def(
       "load",
       [](const std::string& path) -> py::object {

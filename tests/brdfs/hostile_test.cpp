@@ -1,4 +1,4 @@
-// Hostile input (DESIGN.md §7): every file under tests/data/hostile/ makes the
+// Hostile input (docs/design.md §7): every file under tests/data/hostile/ makes the
 // CLI exit 2 with one message naming the file and saying what was wrong,
 // never a crash; the measured readers also reject them directly.
 #include <sys/wait.h>

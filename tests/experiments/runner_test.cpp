@@ -74,7 +74,7 @@ TEST_CASE("runner: outputs, then a re-run reuses every run, --force redoes them"
   CHECK(a.executed == 5);
   CHECK(a.cached == 0);
 
-  // results.csv: DESIGN.md §5's columns first, in order.
+  // results.csv: docs/design.md §5's columns first, in order.
   const std::string header = read_text(out + "/results.csv").substr(0, read_text(out + "/results.csv").find('\n'));
   std::string expected;
   for (const auto& c : required_columns()) expected += (expected.empty() ? "" : ",") + c;
