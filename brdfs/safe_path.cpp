@@ -2,6 +2,7 @@
 #include "brdfs/safe_path.h"
 
 #include <cstdio>
+#include <filesystem>
 #include <stdexcept>
 
 namespace bf {
@@ -41,6 +42,16 @@ void require_plain_name(const std::string& name, const std::string& where) {
                                 ": expected a plain name (1-255 letters, digits, '.', '_' or '-', not '.' or "
                                 "'..'), found " +
                                 quote_for_message(name));
+}
+
+bool has_symlink_below(const std::string& base, const std::string& rel) {
+  std::filesystem::path p(base);
+  for (const auto& part : std::filesystem::path(rel)) {
+    p /= part;
+    std::error_code ec;
+    if (std::filesystem::is_symlink(std::filesystem::symlink_status(p, ec))) return true;
+  }
+  return false;
 }
 
 bool is_path_inside(const std::string& rel) {

@@ -17,8 +17,13 @@ void require_plain_name(const std::string& name, const std::string& where);
 
 // True for a relative path (no leading '/') of 1..4096 characters whose every
 // '/'-separated component is 1..255 bytes, not "." or "..", without control
-// characters: it cannot leave its base folder lexically. (Symbolic links inside the folder are the folder owner's choice.)
+// characters: it cannot leave its base folder lexically.
 bool is_path_inside(const std::string& rel);
+
+// True when some component of base/rel below `base` is a symbolic link (it
+// could lead out of the folder). Call after is_path_inside(rel); it looks only
+// at entries inside `base`, so its answer says nothing about files elsewhere.
+bool has_symlink_below(const std::string& base, const std::string& rel);
 
 // Throws std::invalid_argument("WHERE: expected a file name inside FOLDER_DESC
 // (...), found \"REL\"") unless is_path_inside(rel). Decided from the text

@@ -495,6 +495,11 @@ std::shared_ptr<HomomorphicFactorization> load_factorization(const std::string& 
     if (!is_path_inside(tex))
       s.fail_text(where + ".texture",
                   "a file name inside the sidecar's folder (relative, no '..')", quote_for_message(tex));
+    // A symbolic link inside the folder could point anywhere: refused too.
+    if (has_symlink_below(folder.string(), tex))
+      s.fail_text(where + ".texture",
+                  "a file name inside the sidecar's folder (relative, no '..', not through a symbolic link)",
+                  quote_for_message(tex));
     read_texture((folder / tex).string(), where + ".texture", t);
     terms.push_back(std::move(t));
   }

@@ -188,6 +188,19 @@ TEST_CASE("hostile files: sidecar texture names stay inside the sidecar's folder
     }
     CHECK(msg[0] == msg[1]);
   }
+  // A symbolic link inside the folder to the texture outside it, and a linked subfolder.
+  fs::create_symlink(d.path / "outside.exr", folder / "link.exr");
+  fs::create_directory_symlink(d.path, folder / "linkdir");
+  for (const std::string name : {"link.exr", "linkdir/outside.exr"}) {
+    INFO(name);
+    j["terms"][0]["texture"] = name;
+    const std::string path = (folder / "t-link.json").string();
+    write_text(path, j.dump());
+    std::string err;
+    CHECK(run_cli_stderr("eval --brdf " + path + " --wi 0,0,1 --wo 0,0,1", &err) == 2);
+    INFO(err);
+    CHECK_THAT(err, Contains("field 'terms[0].texture'") && Contains("not through a symbolic link"));
+  }
 }
 
 TEST_CASE("hostile files: a sidecar cannot make the loader allocate without bound") {
