@@ -44,39 +44,9 @@ std::string matrix_comment(const Mat24& P) {
   return os.str();
 }
 
-constexpr const char* kHelpers = R"(// Heidrich-Seidel parabolic map of the upper hemisphere onto the unit disk.
-vec2 brdf_factor_parabolic(vec3 w) { return w.xy / (1.0 + w.z); }
-
-// x = (p(h), p(d)) of the halfdiff parameterization, as brdfs/directions.cpp:
-// h = normalize(wi + wo) (n if wi = -wo); frame r = normalize(t - (t.h) h) with
-// t = +x, or t = +y when that is shorter than 1e-12; s = h x r;
-// d = (wi.r, wi.s, wi.h), except for |wi + wo| < 1 where d.z = |wi + wo| / 2
-// and (d.x, d.y) is rescaled to keep |d| = 1. For unit h, t - (t.h) h with
-// t = +x is (h.y^2 + h.z^2, -h.x h.y, -h.x h.z): written so, it avoids the
-// cancellation in 1 - h.x^2 near h = +-x.
-vec4 brdf_factor_halfdiff(vec3 wi, vec3 wo) {
-  vec3 sum = wi + wo;
-  float n = length(sum);
-  vec3 h = n > 0.0 ? sum / n : vec3(0.0, 0.0, 1.0);
-  vec3 r = vec3(h.y * h.y + h.z * h.z, -h.x * h.y, -h.x * h.z);
-  float rn = length(r);
-  if (rn < 1e-12) {
-    r = vec3(-h.x * h.y, h.x * h.x + h.z * h.z, -h.y * h.z);
-    rn = length(r);
-  }
-  r /= rn;
-  vec3 s = cross(h, r);
-  vec2 dt = vec2(dot(wi, r), dot(wi, s));
-  float dz = dot(wi, h);
-  if (0.5 * n < 0.5) {
-    dz = 0.5 * n;
-    float tn = length(dt);
-    if (tn > 0.0) dt *= sqrt(max(1.0 - dz * dz, 0.0)) / tn;
-  }
-  return vec4(brdf_factor_parabolic(h), brdf_factor_parabolic(vec3(dt, dz)));
-}
-
-// Bilinear lookup of a log-space factor texture at texel coordinates s
+// The parabolic map and the halfdiff point come from glsl_point_helpers()
+// (factor/glsl_target.h), shared with the baseline exports.
+constexpr const char* kHelpers = R"(// Bilinear lookup of a log-space factor texture at texel coordinates s
 // (texel (i, j) centred at s = (i, j)), clamped to [0, res - 1] as bilinear().
 vec3 brdf_factor_lookup(sampler2D tex, vec2 s, float res) {
   s = clamp(s, vec2(0.0), vec2(res - 1.0));
@@ -138,7 +108,7 @@ std::string generate_glsl(const HomomorphicFactorization& f,
     o << ", " << t.proj.res << "x" << t.proj.res << ", " << to_string(t.proj.param)
       << (t.reciprocal ? ", reciprocal" : "") << "\n";
   }
-  o << "\n" << kHelpers << "\n";
+  o << "\n" << glsl_point_helpers() << "\n" << kHelpers << "\n";
 
   bool use[2] = {false, false};
   for (const FactorTerm& t : terms) use[t.proj.param == Parameterization::WiWo ? 0 : 1] = true;

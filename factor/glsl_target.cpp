@@ -33,7 +33,9 @@ vec2 brdf_factor_parabolic(vec3 w) { return w.xy / (1.0 + w.z); }
 // h = normalize(wi + wo) (n if wi = -wo); frame r = normalize(t - (t.h) h) with
 // t = +x, or t = +y when that is shorter than 1e-12; s = h x r;
 // d = (wi.r, wi.s, wi.h), except for |wi + wo| < 1 where d.z = |wi + wo| / 2
-// and (d.x, d.y) is rescaled to keep |d| = 1.
+// and (d.x, d.y) is rescaled to keep |d| = 1. For unit h, t - (t.h) h with
+// t = +x is (h.y^2 + h.z^2, -h.x h.y, -h.x h.z): written so, it avoids the
+// cancellation in 1 - h.x^2 near h = +-x.
 vec4 brdf_factor_halfdiff(vec3 wi, vec3 wo) {
   vec3 sum = wi + wo;
   float n = length(sum);
