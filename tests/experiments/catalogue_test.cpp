@@ -71,7 +71,8 @@ TEST_CASE("catalogue: the method key tables in docs/experiments.md are the catal
 
 TEST_CASE("catalogue: a range in a kind's key spec is the range the reader enforces") {
   // sh-k order: the spec's range (ShkOptions::kMaxOrder) is the reader's and the docs'.
-  const KeySpec& order = find_key(find_method_kind("sh-k")->keys(), "order");
+  const std::vector<KeySpec> keys = find_method_kind("sh-k")->keys();  // by value: keep it alive
+  const KeySpec& order = find_key(keys, "order");
   CHECK(order.int_hi == ShkOptions::kMaxOrder);
   CHECK(order.type_cell().find("0.." + std::to_string(ShkOptions::kMaxOrder)) != std::string::npos);
   require_one_config_error(std::string(kConfigHead) + "[[method]]\nkind = \"sh-k\"\norder = " +

@@ -105,13 +105,15 @@ TEST_CASE("hostile files: FIFOs, devices and folders given as data files are ref
   struct Case {
     std::string brdf, message;
   };
-  // A sidecar whose texture is a FIFO, and one whose texture is /dev/zero
-  // (through a link inside the folder, the names stay confined).
+  // A sidecar whose texture is a FIFO, and one whose texture is a link to
+  // /dev/zero inside the folder (refused as a link before it is opened); a
+  // data file given on the command line as a link to /dev/zero.
   const fs::path folder = fs::path(sidecar).parent_path();
   nlohmann::json j = read_json(sidecar);
   const std::string tex = j["terms"][0]["texture"];
   REQUIRE(::mkfifo((folder / "fifo.exr").c_str(), 0600) == 0);
   fs::create_symlink("/dev/zero", folder / "zero.exr");
+  fs::create_symlink("/dev/zero", d.path / "zero.csv");
   j["terms"][0]["texture"] = "fifo.exr";
   write_text((folder / "fifo_tex.json").string(), j.dump());
   j["terms"][0]["texture"] = "zero.exr";
@@ -123,7 +125,8 @@ TEST_CASE("hostile files: FIFOs, devices and folders given as data files are ref
       {d / "pipe.json", "expected a regular file, found a FIFO"},
       {d / "folder.csv", "expected a regular file, found a directory"},
       {(folder / "fifo_tex.json").string(), "expected a regular file, found a FIFO"},
-      {(folder / "zero_tex.json").string(), "expected a regular file, found a character device"},
+      {(folder / "zero_tex.json").string(), "not through a symbolic link"},
+      {d / "zero.csv", "expected a regular file, found a character device"},
   };
   for (const Case& c : cases) {
     INFO(c.brdf);

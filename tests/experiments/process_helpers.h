@@ -32,9 +32,19 @@ inline Child spawn_cli(const std::vector<std::string>& args, const std::string& 
     std::FILE* f = std::freopen(log.c_str(), "w", stderr);
     if (f) ::dup2(::fileno(stderr), 1);
     if (as_limit_mb > 0) {
+#if defined(__SANITIZE_ADDRESS__)
+      // AddressSanitizer reserves terabytes of shadow address space, so an
+      // address-space limit stops it from starting: bound the allocation
+      // sizes and the resident memory through its own options instead.
+      const char* prev = std::getenv("ASAN_OPTIONS");
+      const std::string opts = std::string(prev ? prev : "") + ":allocator_may_return_null=1:max_allocation_size_mb=" +
+                               std::to_string(as_limit_mb) + ":hard_rss_limit_mb=" + std::to_string(2 * as_limit_mb);
+      ::setenv("ASAN_OPTIONS", opts.c_str(), 1);
+#else
       struct rlimit rl;
       rl.rlim_cur = rl.rlim_max = static_cast<rlim_t>(as_limit_mb) << 20;
       ::setrlimit(RLIMIT_AS, &rl);
+#endif
     }
     std::vector<char*> argv;
     argv.push_back(const_cast<char*>(BF_CLI_PATH));
