@@ -76,21 +76,6 @@ std::string shown(const py::handle& o) {
   return r + " (" + type_name(o) + ")";
 }
 
-size_t edit_distance(const std::string& a, const std::string& b) {
-  std::vector<size_t> d(b.size() + 1);
-  for (size_t j = 0; j <= b.size(); ++j) d[j] = j;
-  for (size_t i = 1; i <= a.size(); ++i) {
-    size_t prev = d[0];
-    d[0] = i;
-    for (size_t j = 1; j <= b.size(); ++j) {
-      const size_t cur = d[j];
-      d[j] = std::min({d[j] + 1, d[j - 1] + 1, prev + (a[i - 1] == b[j - 1] ? 0 : 1)});
-      prev = cur;
-    }
-  }
-  return d[b.size()];
-}
-
 }  // namespace
 
 Options::Options(std::string kind, const py::kwargs& kw) : kind_(std::move(kind)) {
@@ -249,12 +234,7 @@ void Options::finish() {
   for (size_t i = 0; i < accepted.size(); ++i) list += (i ? ", " : "") + accepted[i];
   std::string msg;
   for (const auto& [key, value] : values_) {
-    std::string best;
-    size_t bd = 3;
-    for (const auto& a : accepted)
-      if (const size_t d = edit_distance(key, a); d < bd) bd = d, best = a;
-    msg += (msg.empty() ? "" : "; ") + std::string("unknown option '") + key + "'" +
-           (best.empty() ? "" : " (did you mean '" + best + "'?)");
+    msg += (msg.empty() ? "" : "; ") + std::string("unknown option '") + key + "'" + did_you_mean(key, accepted);
   }
   fail(msg + " (accepted: " + list + ")");
 }
