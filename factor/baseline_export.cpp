@@ -14,6 +14,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "factor/atomic_batch.h"
 #include "factor/export.h"  // kFactorExportFormat, kFactorExportFormatVersion
 #include "factor/glsl_target.h"
 #include "factor/image_io.h"
@@ -29,40 +30,6 @@ using nlohmann::json;
 namespace {
 
 // ---------------------------------------------------------------- writing
-
-// Temporaries in the target folder renamed into place in the order added;
-// the destructor removes what was not committed.
-class Batch {
- public:
-  explicit Batch(fs::path dir) : dir_(std::move(dir)) {}
-  Batch(const Batch&) = delete;
-  Batch& operator=(const Batch&) = delete;
-  ~Batch() {
-    std::error_code ec;
-    for (const auto& f : files_) fs::remove(f.first, ec);
-  }
-  fs::path add(const std::string& name) {
-    static std::atomic<unsigned> counter{0};
-    const fs::path tmp = dir_ / ("." + name + ".tmp-" + std::to_string(::getpid()) + "-" +
-                                 std::to_string(counter++));
-    files_.emplace_back(tmp, dir_ / name);
-    return tmp;
-  }
-  void commit() {
-    for (const auto& [tmp, final_path] : files_) {
-      std::error_code ec;
-      fs::rename(tmp, final_path, ec);
-      if (ec)
-        throw std::runtime_error(final_path.string() + ": cannot rename the temporary " +
-                                 tmp.string() + " into place: " + ec.message());
-    }
-    files_.clear();
-  }
-
- private:
-  fs::path dir_;
-  std::vector<std::pair<fs::path, fs::path>> files_;
-};
 
 void write_bytes(const fs::path& tmp, const fs::path& final_path, const void* data, size_t n) {
   std::ofstream out(tmp, std::ios::binary);
@@ -638,7 +605,7 @@ BaselineExportFiles write_baseline_export(const Factorization& f, const std::str
   fs::create_directories(folder, ec);
   if (ec) throw std::runtime_error(dir + ": cannot create folder: " + ec.message());
   BaselineExportFiles out;
-  Batch batch(folder);
+  AtomicBatch batch(folder);
   {
     const fs::path tmp = batch.add(stem + ".f64");
     write_bytes(tmp, folder / (stem + ".f64"), d.values.data(), d.values.size() * sizeof(double));

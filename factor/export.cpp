@@ -20,6 +20,7 @@
 #include <stdexcept>
 
 #include "brdfs/catalogue.h"
+#include "factor/atomic_batch.h"
 #include "factor/baseline_export.h"
 #include "factor/glsl.h"
 #include "factor/image_io.h"
@@ -35,54 +36,6 @@ namespace {
 const char* const kChannel[3] = {"R", "G", "B"};
 
 // ---------------------------------------------------------------- writing
-
-// Files written to hidden temporaries in the target folder, renamed into place
-// by commit() in the order they were added; the destructor removes whatever
-// was not committed.
-class AtomicBatch {
- public:
-  explicit AtomicBatch(fs::path dir) : dir_(std::move(dir)) {}
-  AtomicBatch(const AtomicBatch&) = delete;
-  AtomicBatch& operator=(const AtomicBatch&) = delete;
-  ~AtomicBatch() {
-    std::error_code ec;
-    for (const auto& [tmp, final_path] : files_) fs::remove(tmp, ec);
-  }
-
-  // A fresh temporary path for the final file `name` (in the same folder, so
-  // the rename is atomic).
-  fs::path add(const std::string& name) {
-    const fs::path tmp = create_unique_temp((dir_ / name).string());
-    files_.emplace_back(tmp, dir_ / name);
-    return tmp;
-  }
-
-  void commit() {
-    for (const auto& [tmp, final_path] : files_) sync_path(tmp);
-    for (const auto& [tmp, final_path] : files_) {
-      std::error_code ec;
-      fs::rename(tmp, final_path, ec);
-      if (ec)
-        throw std::runtime_error(final_path.string() + ": cannot rename the temporary " +
-                                 tmp.string() + " into place: " + ec.message());
-    }
-    files_.clear();
-    sync_path(dir_);
-  }
-
- private:
-  // Flush a file or folder to disk, so that a crash after the rename cannot
-  // leave a complete name pointing at incomplete data. Best effort.
-  static void sync_path(const fs::path& p) {
-    const int fd = ::open(p.c_str(), O_RDONLY);
-    if (fd < 0) return;
-    ::fsync(fd);
-    ::close(fd);
-  }
-
-  fs::path dir_;
-  std::vector<std::pair<fs::path, fs::path>> files_;
-};
 
 void write_text(const fs::path& tmp, const fs::path& final_path, const std::string& text) {
   std::ofstream out(tmp, std::ios::binary);
