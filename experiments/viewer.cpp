@@ -16,6 +16,8 @@
 #include "factor/homomorphic.h"
 #include "factor/image_io.h"
 #include "factor/lighting.h"
+#include "factor/model_fit.h"
+#include "factor/model_glsl.h"
 #include "factor/svd_baseline.h"
 
 namespace bf {
@@ -45,8 +47,17 @@ nlohmann::json texture_json(const std::string& sampler, const FloatImage& img) {
 
 }  // namespace
 
+namespace {
+// The fitted model of a model fit with generated GLSL, else nullptr.
+const Brdf* fitted_model(const Factorization& f) {
+  const auto* m = dynamic_cast<const ModelFitFactorization*>(&f);
+  return m && m->result().brdf && has_model_glsl(*m->result().brdf) ? m->result().brdf.get() : nullptr;
+}
+}  // namespace
+
 bool viewer_supports(const Factorization& f) {
-  return dynamic_cast<const HomomorphicFactorization*>(&f) != nullptr || is_baseline_method(f.method());
+  return dynamic_cast<const HomomorphicFactorization*>(&f) != nullptr || is_baseline_method(f.method()) ||
+         fitted_model(f) != nullptr;
 }
 
 void write_viewer_data(const Factorization& approx, const Brdf& original, const SphereRender& original_render,
@@ -73,6 +84,8 @@ void write_viewer_data(const Factorization& approx, const Brdf& original, const 
   } else if (is_baseline_method(approx.method())) {
     j["glsl"] = generate_baseline_glsl(approx, "factors");
     for (const auto& [sampler, img] : baseline_textures(approx)) tex.push_back(texture_json(sampler, img));
+  } else if (const Brdf* model = fitted_model(approx)) {
+    j["glsl"] = generate_model_glsl(*model, "report.html viewer");  // model.glsl; no textures
   } else {
     throw std::invalid_argument("viewer: method '" + approx.method() + "' has no GLSL");
   }

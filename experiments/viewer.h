@@ -4,7 +4,8 @@
 //
 // viewer.js sets window.BF_VIEWER[run_id] = {
 //   label, method,
-//   glsl:      the run's exported GLSL (the same text as factors.glsl),
+//   glsl:      the run's exported GLSL (the same text as factors.glsl; for
+//              model-fit the formula of model.glsl, no textures),
 //   textures:  [{sampler, width, height, data}] float32 RGB, base64, in
 //              binding order (the export's EXR contents),
 //   original:  the original BRDF tabulated, float32 RGB base64:
@@ -39,7 +40,8 @@ inline constexpr int kViewerIsoThetaH = 64, kViewerIsoThetaD = 32, kViewerIsoPhi
 inline constexpr int kViewerEnvWidth = 128;
 
 // True when the viewer can show this factorization (it has exported GLSL:
-// mccool, fit, search, svd, sh-k, sh-r).
+// mccool, fit, search, svd, sh-k, sh-r, and model-fit: the fitted analytic
+// model's formula, factor/model_glsl.h).
 bool viewer_supports(const Factorization& f);
 
 // Writes viewer.js (atomically). original_render: the CPU render of the

@@ -1,6 +1,11 @@
 // See glsl_target.h.
 #include "factor/glsl_target.h"
 
+#include <cfloat>
+#include <cmath>
+#include <cstdio>
+#include <stdexcept>
+
 namespace bf {
 
 std::string glsl_target_prelude() {
@@ -23,6 +28,16 @@ std::string glsl_target_prelude() {
 
 std::string glsl_sampler_decl(const std::string& name, int binding) {
   return "BRDF_FACTOR_BINDING(" + std::to_string(binding) + ") uniform sampler2D " + name + ";";
+}
+
+std::string glsl_float(double v, const std::string& what) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.9g", v);
+  if (!std::isfinite(v) || std::abs(v) > FLT_MAX)
+    throw std::invalid_argument("glsl: " + what + " = " + buf + " is not a finite float32 (|value| <= 3.4e38)");
+  std::string s = buf;
+  if (s.find_first_of(".e") == std::string::npos) s += ".0";
+  return s;
 }
 
 const char* glsl_point_helpers() {

@@ -20,6 +20,11 @@ std::string glsl_target_prelude();
 // "BRDF_FACTOR_BINDING(binding) uniform sampler2D name;"
 std::string glsl_sampler_decl(const std::string& name, int binding);
 
+// A GLSL float literal that rounds to the same float32 as v (9 significant
+// digits), always with a '.' or an exponent. Throws std::invalid_argument
+// naming `what` when v is not finite or beyond float32's range.
+std::string glsl_float(double v, const std::string& what);
+
 // GLSL helpers shared by the SVD and SH exports: brdf_factor_parabolic(vec3)
 // and brdf_factor_halfdiff(vec3 wi, vec3 wo) (the x = (p(h), p(d)) of docs/design.md
 // §2.3, grazing branch and t = +y fallback included). The homomorphic export

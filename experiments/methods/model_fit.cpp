@@ -1,10 +1,13 @@
 // kind = "model-fit": an analytic catalogue model fitted to the samples with
 // Ceres (multi-start Levenberg–Marquardt; factor/model_fit.h), as one more way
-// to compress a BRDF; the fit is written as runs/<id>/model.json, itself a BRDF.
+// to compress a BRDF; the fit is written as runs/<id>/model.json, itself a BRDF,
+// and its formula with the fitted parameters as runs/<id>/model.glsl.
 #include <algorithm>
 
+#include "experiments/cli_util.h"
 #include "experiments/methods/method_kind.h"
 #include "factor/model_fit.h"
+#include "factor/model_glsl.h"
 #include "solvers/option_error.h"
 #include "solvers/parallel.h"
 
@@ -57,7 +60,9 @@ class ModelFitKind final : public MethodKind {
            "`factor/model_fit.h`): the row is scored on the same samples as every method, `storage_floats` is "
            "the number of fitted parameters, `terms`/`texture_size` are empty, the `model` column holds the "
            "fitted catalogue spec and `runs/<id>/model.json` the fit (format `brdf-factor-model-fit`), itself "
-           "a BRDF (`brdf-factor eval --brdf runs/<id>/model.json ...`).";
+           "a BRDF (`brdf-factor eval --brdf runs/<id>/model.json ...`); `runs/<id>/model.glsl` is the "
+           "model's formula with the fitted parameters, `vec3 brdf_factor_eval(vec3 wi, vec3 wo)` for GL 3.3 / "
+           "4.5, GLES 3.0 and Vulkan (`factor/model_glsl.h`).";
   }
   std::vector<KeySpec> keys() const override { return model_fit_keys(); }
   bool seeded() const override { return true; }
@@ -116,6 +121,8 @@ class ModelFitKind final : public MethodKind {
   void export_files(const RunContext& c, const MethodOutcome& out) const override {
     const auto mf = std::dynamic_pointer_cast<const ModelFitFactorization>(out.result);
     write_model_fit(mf->result(), (c.run_dir / "model.json").string());
+    const std::string glsl = generate_model_glsl(*mf->result().brdf, "run " + c.run.run_id);
+    write_file_atomic((c.run_dir / "model.glsl").string(), [&](std::ostream& o) { o << glsl; });
   }
 };
 

@@ -8,6 +8,7 @@
 #include "experiments/outputs.h"
 #include "factor/metrics.h"
 #include "factor/model_fit.h"
+#include "factor/model_glsl.h"
 #include "experiments_helpers.h"
 
 using namespace bf;
@@ -188,6 +189,10 @@ starts = 2
     const BrdfPtr truth = Catalogue::builtin().make("ward:kd=0.2,ks=0.25,ax=0.2,ay=0.2");
     const Vec3 wi = Vec3(0.3, 0.1, 0.9).normalized(), wo = Vec3(-0.2, 0.05, 0.95).normalized();
     CHECK((back->eval(wi, wo) - truth->eval(wi, wo)).abs().maxCoeff() < 1e-6 * truth->eval(wi, wo).maxCoeff());
+    // model.glsl beside it: the fitted model's formula (factor/model_glsl.h;
+    // compiled and run against eval in tests/factor/model_glsl_test.cpp).
+    CHECK(read_text(tmp / ("out/runs/" + r.at("run_id") + "/model.glsl")) ==
+          generate_model_glsl(*back, "run " + r.at("run_id")));
     std::string out;
     CHECK(run_cli("eval --brdf " + file + " --wi 0,0,1 --wo 0.5,0,0.866", &out) == 0);
     INFO(out);

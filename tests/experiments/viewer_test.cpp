@@ -4,7 +4,7 @@
 // render of the run's export, its slices equal `eval` of the export, and its
 // original panel (the page's tabulation) is close to the CPU render and eval
 // of the BRDF. Kinds: mccool, svd (halfdiff, log), sh-k (reduced and full),
-// sh-r.
+// sh-r, model-fit (lafortune).
 #include <cmath>
 #include <cstdlib>
 #include <nlohmann/json.hpp>
@@ -54,6 +54,13 @@ reduce_isotropic = [true, false]
 
 [[method]]
 kind = "sh-r"
+
+[[method]]
+kind = "model-fit"
+model = "lafortune"
+starts = 1
+max_iterations = 30
+threads = 1
 )";
 
 std::string chromium() {
@@ -108,7 +115,11 @@ TEST_CASE("viewer: headless Chromium renders every kind as the CPU does") {
     INFO("run " << id << " " << (j.contains("error") ? j["error"].get<std::string>() : ""));
     REQUIRE(!j.contains("error"));
     ++runs;
-    const BrdfPtr approx = Catalogue::global().make(dir / ("out/runs/" + id + "/factors.json"));
+    // The run's export: factors.json, or model.json for a model fit.
+    const std::string run_dir = dir / ("out/runs/" + id);
+    const BrdfPtr approx = Catalogue::global().make(run_dir + (std::filesystem::exists(run_dir + "/model.json")
+                                                                   ? "/model.json"
+                                                                   : "/factors.json"));
     INFO(approx->to_string());
     // Sphere radiance: every pixel within 1e-3 of the render's peak radiance.
     const SphereRender cpu = render_sphere(*approx, scene);
@@ -180,7 +191,7 @@ TEST_CASE("viewer: headless Chromium renders every kind as the CPU does") {
       CHECK(w <= 3e-3 * pk);
     }
   }
-  CHECK(runs == 5);
+  CHECK(runs == 6);
 }
 
 TEST_CASE("viewer: under the scene's SH lighting the page shades as render_sphere") {

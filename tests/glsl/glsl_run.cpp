@@ -3,7 +3,7 @@
 // (llvmpipe) through a surfaceless EGL context, so that a test can compare the
 // shader's values with the CPU model's. Used by tests/factor/export_test.cpp.
 //
-//   bf_glsl_run GLSL DIRS OUT [--exact] TEX0.exr [TEX1.exr ...]
+//   bf_glsl_run GLSL DIRS OUT [--exact] [TEX0.exr TEX1.exr ...]
 //
 // GLSL: the generated file. DIRS: one direction pair per line,
 // "wi.x wi.y wi.z wo.x wo.y wo.z". OUT: one line per pair, "r g b" of
@@ -11,7 +11,9 @@
 // the generated header asks: GL_RGB32F, the file's scanline 0 as the first
 // row, GL_LINEAR, no mipmaps, GL_CLAMP_TO_EDGE. --exact defines
 // BRDF_FACTOR_EXACT_BILINEAR (texelFetch path). Exit 1 with a message on any
-// failure (no EGL display, context, compile or link error, bad input).
+// failure (no EGL display, context, compile or link error, bad input). A
+// shader without textures (an analytic model's, factor/model_glsl.h) takes
+// none. Also used by tests/factor/model_glsl_test.cpp.
 #define GL_GLEXT_PROTOTYPES
 #include <EGL/egl.h>
 #include <EGL/eglext.h>
@@ -73,11 +75,11 @@ GLuint upload(const std::vector<float>& px, int w, int h, bool linear) {
 }
 
 int run(int argc, char** argv) {
-  if (argc < 5) throw std::runtime_error("usage: bf_glsl_run GLSL DIRS OUT [--exact] TEX0.exr [TEX1.exr ...]");
+  if (argc < 4) throw std::runtime_error("usage: bf_glsl_run GLSL DIRS OUT [--exact] [TEX0.exr TEX1.exr ...]");
   const std::string glsl = read_file(argv[1]);
   int a = 4;
   bool exact = false;
-  if (std::string(argv[a]) == "--exact") exact = true, ++a;
+  if (a < argc && std::string(argv[a]) == "--exact") exact = true, ++a;
   std::vector<std::string> textures(argv + a, argv + argc);
 
   // Direction pairs.
