@@ -66,6 +66,23 @@ void write_file_atomic(const std::string& path, const std::function<void(std::os
   }
 }
 
+bool write_file_if_changed(const std::string& path, const std::function<void(std::ostream&)>& body) {
+  namespace fs = std::filesystem;
+  std::ostringstream o;
+  body(o);
+  const std::string text = o.str();
+  std::error_code ec;
+  if (fs::is_regular_file(fs::symlink_status(path, ec)) && fs::file_size(path, ec) == text.size() && !ec) {
+    std::ifstream in(path, std::ios::binary);
+    std::string old(text.size(), '\0');
+    if (in.read(old.data(), static_cast<std::streamsize>(old.size())) && in.peek() == std::char_traits<char>::eof() &&
+        old == text)
+      return false;
+  }
+  write_file_atomic(path, [&](std::ostream& out) { out << text; });
+  return true;
+}
+
 std::string join(const std::vector<std::string>& v, const std::string& sep) {
   std::string s;
   for (size_t i = 0; i < v.size(); ++i) s += (i ? sep : "") + v[i];

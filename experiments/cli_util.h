@@ -24,4 +24,10 @@ std::string join(const std::vector<std::string>& v, const std::string& sep = ", 
 // path when it cannot be written.
 void write_file_atomic(const std::string& path, const std::function<void(std::ostream&)>& body);
 
+// As write_file_atomic, but leaves the file untouched (its bytes and mtime)
+// when it is a regular file (not a link) that already holds exactly what body
+// writes, so that pages regenerated from unchanged inputs keep their
+// timestamps (report.html, results.md). Returns whether the file was written.
+bool write_file_if_changed(const std::string& path, const std::function<void(std::ostream&)>& body);
+
 }  // namespace bf

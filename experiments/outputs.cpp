@@ -263,7 +263,7 @@ std::string md_cell(const std::string& s) {
 
 void write_results_md(const ExperimentOutput& e, const OutputFiles& f, const std::string& path) {
   const json& x = e.experiment;
-  write_file_atomic(path, [&](std::ostream& o) {
+  write_file_if_changed(path, [&](std::ostream& o) {  // unchanged: file and mtime kept
     o << "# Experiment " << x.value("name", "") << "\n\n";
     if (!x.value("description", "").empty()) o << x.value("description", "") << "\n\n";
     size_t failed = 0;

@@ -239,7 +239,8 @@ void write_report_html(const ExperimentOutput& e, const OutputFiles& f, const st
     h << "</p></div>\n";
   }
   h << "<h2>Config</h2>\n<pre>" << esc(e.config_text) << "</pre>\n</body></html>\n";
-  write_file_atomic(path, [&](std::ostream& o) { o << h.str(); });
+  // Unchanged inputs give the same page: keep the file (and its mtime) then.
+  write_file_if_changed(path, [&](std::ostream& o) { o << h.str(); });
 }
 
 }  // namespace bf
