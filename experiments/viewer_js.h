@@ -19,6 +19,9 @@ uniform int u_env;          // 1: light by the scene's SH lighting (lat-long bf_
 uniform sampler2D bf_env;
 uniform sampler2D bf_rule;  // node k at (k, 0): (direction in the local frame, weight)
 uniform int u_rule_n;
+// The lighting is read at u_env_rot * (world direction): u_env_rot = R^T for
+// an environment turned by R (dragging the light turns it, see the script).
+uniform mat3 u_env_rot;
 out vec4 o_color;
 
 // Bilinear lookup of the lat-long map (theta = pi (y + 1/2) / H, phi = 2 pi (x + 1/2) / W),
@@ -120,7 +123,7 @@ void main() {
         for (int k = 0; k < u_rule_n; ++k) {
           vec4 node = texelFetch(bf_rule, ivec2(k, 0), 0);
           vec3 sw = node.x * t + node.y * b + node.z * n;
-          L += node.w * node.z * bf_env_radiance(sw) * bf_eval(node.xyz, won);
+          L += node.w * node.z * bf_env_radiance(u_env_rot * sw) * bf_eval(node.xyz, won);
         }
       }
     } else if (ci > 0.0 && wo.z > 0.0) {
@@ -237,6 +240,8 @@ function run(id, mode, which, w, h, u) {
   gl.uniform1f(L("u_phi_d"), u.phi_d);
   gl.uniform1i(L("u_env"), u.env && r.environment ? 1 : 0);
   gl.uniform1i(L("u_rule_n"), r.environment ? r.environment.nodes : 0);
+  // u.env_rot is R row-major; read as column-major it is R^T, the lookup matrix.
+  gl.uniformMatrix3fv(L("u_env_rot"), false, u.env_rot || [1, 0, 0, 0, 1, 0, 0, 0, 1]);
   gl.drawArrays(gl.TRIANGLES, 0, 3);
   const px = new Float32Array(w * h * 4);
   gl.readPixels(0, 0, w, h, gl.RGBA, gl.FLOAT, px);
@@ -290,7 +295,32 @@ function camMatrix() {
   // world = Ry(yaw) Rx(pitch) camera, column-major for uniformMatrix3fv.
   return [cy, 0, -sy, sy * sp, cp, cy * sp, sy * cp, -sp, cy * cp];
 }
-function uniforms() { return {light: state.light, cam: state.cam, theta_i: state.theta_i, phi_d: state.phi_d, env: state.env}; }
+const unit = (v) => { const n = Math.hypot(...v); return v.map((x) => x / n); };
+// The smallest rotation R with R a = b (unit vectors; row-major 3x3), about
+// a x b (Rodrigues: R = c I + s [k]x + (1 - c) k k^T); a half turn about an
+// axis normal to a when b = -a.
+function rotation(a, b) {
+  let c = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+  let k = [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
+  let s = Math.hypot(...k);
+  if (s < 1e-9) {
+    if (c > 0) return [1, 0, 0, 0, 1, 0, 0, 0, 1];
+    k = Math.abs(a[0]) < 0.9 ? [0, a[2], -a[1]] : [-a[2], 0, a[0]];  // a x (1,0,0) or a x (0,1,0)
+    s = 0; c = -1;
+  }
+  k = unit(k);
+  const K = [0, -k[2], k[1], k[2], 0, -k[0], -k[1], k[0], 0], R = [];
+  for (let i = 0; i < 3; ++i)
+    for (let j = 0; j < 3; ++j) R.push((i === j ? c : 0) + s * K[3 * i + j] + (1 - c) * k[i] * k[j]);
+  return R;
+}
+// With the scene's environment, moving the light turns the environment by the
+// rotation that takes the scene's light direction to the light's.
+function envRotation(light) { return rotation(unit(runs[state.id].scene.light), unit(light)); }
+function uniforms() {
+  return {light: state.light, cam: state.cam, theta_i: state.theta_i, phi_d: state.phi_d, env: state.env,
+          env_rot: envRotation(state.light)};
+}
 function draw() {
   const id = state.id, r = runs[id], n = 160;
   const u = uniforms();
@@ -345,12 +375,15 @@ function draw() {
   ctx.fillText("radius: f (mean RGB), full scale " + fmt(fmax) + " 1/sr; grey: light at " +
                Math.round(state.theta_i * 180 / Math.PI) + " deg", 6, H - 4);
   $("v-info").textContent = r.label + " (" + r.method + "), " +
-      (state.env && r.environment ? "lit by the scene's SH lighting (" + r.environment.nodes + " hemisphere nodes per pixel)"
+      (state.env && r.environment ? "lit by the scene's SH lighting (" + r.environment.nodes + " hemisphere nodes per pixel), turned " +
+                                    Math.round(Math.acos(Math.min(1, Math.max(-1, (u.env_rot[0] + u.env_rot[4] + u.env_rot[8] - 1) / 2))) * 180 / Math.PI) +
+                                    " deg with the light"
                                   : "point light (" + state.light.map((v) => v.toFixed(2)).join(", ") + ")") +
-      "), view yaw " + Math.round(state.yaw * 180 / Math.PI) + " pitch " + Math.round(state.pitch * 180 / Math.PI) + " deg";
+      ", view yaw " + Math.round(state.yaw * 180 / Math.PI) + " pitch " + Math.round(state.pitch * 180 / Math.PI) + " deg";
   // Factor textures with their value scale.
   const tx = $("v-textures");
-  tx.textContent = "";
+  tx.textContent = r.textures.length ? "" : "No factor textures: the " +
+      (r.method === "model-fit" ? "fitted parameters" : "coefficients") + " are constants of the GLSL.";
   r.textures.forEach((t) => {
     const d = b64floats(t.data);
     let a = Number.MAX_VALUE, b = -Number.MAX_VALUE;
@@ -429,6 +462,10 @@ if (testMode) {
       if (r.environment) {
         const ue = Object.assign({}, u, {env: true});
         rec.approx_env = pick(run(id, 0, 1, n, n, ue), n, n);
+        // The light dragged to (-0.4, 0.5, 0.75) (direction): the environment turns with it.
+        state.id = id;
+        rec.env_rot = envRotation([-0.4, 0.5, 0.75]);
+        rec.approx_env_turned = pick(run(id, 0, 1, n, n, Object.assign({}, ue, {env_rot: rec.env_rot})), n, n);
       }
     } catch (e) { rec.error = String(e.message || e); }
     out.push(JSON.stringify(rec));

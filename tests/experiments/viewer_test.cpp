@@ -3,7 +3,8 @@
 // the viewer's sphere radiance of the approximation equals the CPU sphere
 // render of the run's export, its slices equal `eval` of the export, and its
 // original panel (the page's tabulation) is close to the CPU render and eval
-// of the BRDF. Kinds: mccool, svd (halfdiff, log), sh-k (reduced and full),
+// of the BRDF; under SH lighting the page shades as render_sphere, also with
+// the environment turned by a dragged light. Kinds: mccool, svd (halfdiff, log), sh-k (reduced and full),
 // sh-r, model-fit (lafortune).
 #include <cmath>
 #include <cstdlib>
@@ -257,6 +258,40 @@ texture_size = 10
     // The page reads the band-limited lighting from a 128 x 64 lat-long grid
     // (bilinear) where the CPU evaluates the SH series: 2e-3 of the peak.
     CHECK(worst <= 2e-3 * peak);
+
+    // The light dragged to direction b: the page turns the environment by the
+    // smallest rotation R taking the scene light's direction a to b. Check R
+    // (R a = b, a rotation about a x b), then the page's radiance against the
+    // CPU render under the lighting rotated by R (L'(s) = L(R^T s), sh_rotate).
+    REQUIRE(j.contains("env_rot"));
+    const auto rv = j.at("env_rot").get<std::vector<double>>();
+    REQUIRE(rv.size() == 9);
+    Eigen::Matrix3d R;
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) R(r, c) = rv[3 * r + c];
+    const Vec3 a = plan.scene.light.normalized(), b = Vec3(-0.4, 0.5, 0.75).normalized();
+    CHECK((R * a - b).norm() < 1e-6);
+    CHECK((R * a.cross(b) - a.cross(b)).norm() < 1e-6);
+    CHECK((R.transpose() * R - Eigen::Matrix3d::Identity()).norm() < 1e-6);
+    CHECK(R.determinant() == Approx(1.0).epsilon(1e-6));
+    ShLighting turned = *plan.scene.lighting;
+    for (int c = 0; c < 3; ++c) turned.coeffs[c] = sh_rotate(R, turned.coeffs[c]);
+    SceneSettings scene = plan.scene;
+    scene.lighting = std::make_shared<const ShLighting>(turned);
+    const SphereRender cpu_t = render_sphere(*approx, scene);
+    const auto gpu_t = j.at("approx_env_turned").get<std::vector<double>>();
+    REQUIRE(gpu_t.size() == cpu_t.L.size() * 3);
+    double worst_t = 0, peak_t = 0, moved = 0;
+    for (size_t k = 0; k < cpu_t.L.size(); ++k)
+      for (int c = 0; c < 3; ++c) {
+        worst_t = std::max(worst_t, std::abs(gpu_t[3 * k + c] - cpu_t.L[k][c]));
+        peak_t = std::max(peak_t, std::abs(cpu_t.L[k][c]));
+        moved = std::max(moved, std::abs(cpu_t.L[k][c] - cpu.L[k][c]));
+      }
+    INFO("turned environment: worst |gpu - cpu| = " << worst_t << " of peak " << peak_t
+                                                     << "; the turn changes the render by " << moved);
+    CHECK(moved > 0.1 * peak);  // the turn is visible
+    CHECK(worst_t <= 2e-3 * peak_t);
   }
   CHECK(runs == 2);
 }
