@@ -3,17 +3,19 @@
 // (llvmpipe) through a surfaceless EGL context, so that a test can compare the
 // shader's values with the CPU model's. Used by tests/factor/export_test.cpp.
 //
-//   bf_glsl_run GLSL DIRS OUT [--exact] [TEX0.exr TEX1.exr ...]
+//   bf_glsl_run GLSL DIRS OUT [--exact] [[SAMPLER=]TEX.exr ...]
 //
 // GLSL: the generated file. DIRS: one direction pair per line,
 // "wi.x wi.y wi.z wo.x wo.y wo.z". OUT: one line per pair, "r g b" of
-// brdf_factor_eval(wi, wo). TEXk.exr is bound to brdf_factor_texk exactly as
+// brdf_factor_eval(wi, wo). The k-th texture is bound to the sampler SAMPLER,
+// or without "SAMPLER=" to brdf_factor_texk (the homomorphic export's), exactly as
 // the generated header asks: GL_RGB32F, the file's scanline 0 as the first
 // row, GL_LINEAR, no mipmaps, GL_CLAMP_TO_EDGE. --exact defines
 // BRDF_FACTOR_EXACT_BILINEAR (texelFetch path). Exit 1 with a message on any
 // failure (no EGL display, context, compile or link error, bad input). A
 // shader without textures (an analytic model's, factor/model_glsl.h) takes
-// none. Also used by tests/factor/model_glsl_test.cpp.
+// none. Also used by tests/factor/model_glsl_test.cpp and
+// baseline_export_test.cpp (SAMPLER=: brdf_factor_rows, ...).
 #define GL_GLEXT_PROTOTYPES
 #include <EGL/egl.h>
 #include <EGL/eglext.h>
@@ -75,7 +77,7 @@ GLuint upload(const std::vector<float>& px, int w, int h, bool linear) {
 }
 
 int run(int argc, char** argv) {
-  if (argc < 4) throw std::runtime_error("usage: bf_glsl_run GLSL DIRS OUT [--exact] [TEX0.exr TEX1.exr ...]");
+  if (argc < 4) throw std::runtime_error("usage: bf_glsl_run GLSL DIRS OUT [--exact] [[SAMPLER=]TEX.exr ...]");
   const std::string glsl = read_file(argv[1]);
   int a = 4;
   bool exact = false;
@@ -154,12 +156,14 @@ int run(int argc, char** argv) {
   for (size_t k = 0; k < textures.size(); ++k, ++unit) {
     // Read with OpenEXR itself (not the toolkit's reader): R, G, B interleaved,
     // scanline 0 first.
-    Imf::InputFile in(textures[k].c_str());
+    std::string name = "brdf_factor_tex" + std::to_string(k), file = textures[k];
+    if (const size_t eq = file.find('='); eq != std::string::npos) name = file.substr(0, eq), file = file.substr(eq + 1);
+    Imf::InputFile in(file.c_str());
     const Imath::Box2i dw = in.header().dataWindow();
     const int w = dw.max.x - dw.min.x + 1, h = dw.max.y - dw.min.y + 1;
-    for (const char* name : {"R", "G", "B"})
-      if (!in.header().channels().findChannel(name))
-        throw std::runtime_error(textures[k] + ": expected channels R, G, B");
+    for (const char* ch : {"R", "G", "B"})
+      if (!in.header().channels().findChannel(ch))
+        throw std::runtime_error(file + ": expected channels R, G, B");
     std::vector<float> px(size_t(w) * h * 3);
     Imf::FrameBuffer fb;
     const char* names[3] = {"R", "G", "B"};
@@ -170,7 +174,6 @@ int run(int argc, char** argv) {
     in.readPixels(dw.min.y, dw.max.y);
     glActiveTexture(GL_TEXTURE0 + unit);
     upload(px, w, h, true);  // scanline 0 = first row, GL_LINEAR
-    const std::string name = "brdf_factor_tex" + std::to_string(k);
     const GLint loc = glGetUniformLocation(prog, name.c_str());
     if (loc < 0) throw std::runtime_error("GL: the shader has no sampler " + name);
     glUniform1i(loc, unit);
