@@ -53,16 +53,18 @@ const fs::path& runner() {
   return r;
 }
 
-// Compiles the model's GLSL for the four targets and runs it on llvmpipe at
-// pairs(); returns the worst |GLSL - eval| relative to max(|eval|, 1e-3 of the
+// Compiles the model's GLSL for the four targets (with all_targets) and runs
+// it on llvmpipe at pairs(); returns the worst |GLSL - eval| relative to max(|eval|, 1e-3 of the
 // model's peak over the pairs) (float32 arithmetic: where eval is tiny, its
 // absolute error is what the picture sees).
-double glsl_error(const Brdf& b, const fs::path& dir) {
+double glsl_error(const Brdf& b, const fs::path& dir, bool all_targets) {
   const std::string glsl = generate_model_glsl(b, "model_glsl_test");
   CHECK_THAT(glsl, Contains("vec3 brdf_factor_eval(vec3 wi, vec3 wo)"));
-  const std::string err = bf_test::compile_glsl_all_targets(glsl, dir);
   INFO(glsl);
-  CHECK(err.empty());
+  if (all_targets) {
+    const std::string err = bf_test::compile_glsl_all_targets(glsl, dir);
+    CHECK(err.empty());
+  }
   const auto pr = pairs();
   {
     std::ofstream(dir / "model.glsl") << glsl;
@@ -123,7 +125,7 @@ TEST_CASE("model glsl: every analytic model and variant runs on the GPU as eval"
     const BrdfPtr b = Catalogue::builtin().make(spec);
     INFO(spec);
     REQUIRE(has_model_glsl(*b));
-    const double worst = glsl_error(*b, dir.path);
+    const double worst = glsl_error(*b, dir.path, true);
     // Measured at most 2.1e-5 (blinn-phong n = 5000: float32 exp of a large
     // exponent), most below 1e-5; docs/report.md.
     INFO("worst relative |GLSL - eval| " << worst);
@@ -180,8 +182,8 @@ TEST_CASE("model glsl: the export of every fitted model reloads as the fit and i
     INFO("reload: worst relative difference " << worst);
     CHECK(nonzero > 600);
     CHECK(worst <= 1e-6);
-    // The GLSL of the fit.
-    const double g = glsl_error(*fit.result().brdf, dir.path);
+    // The GLSL of the fit (the four targets: every variant above).
+    const double g = glsl_error(*fit.result().brdf, dir.path, false);
     INFO("worst relative |GLSL - eval| " << g);
     CHECK(g < 1e-4);
   }
