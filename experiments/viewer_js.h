@@ -476,6 +476,16 @@ if (testMode) {
 const wanted = location.hash.startsWith("#viewer=") ? location.hash.slice(8) : "";
 show(ids.includes(wanted) ? wanted : ids[0]);
 if (location.hash.startsWith("#viewer")) $("viewer-h").scrollIntoView();
+if (testMode) {
+  // A drag through the real handlers (the first run, shown above): pointer
+  // down and up at (x, y) = (0.3, 0.4) of the original sphere's half-width
+  // from its centre; the test checks the light and the environment's turn.
+  const cv = $("v-orig"), b = cv.getBoundingClientRect(), x = 0.3, y = 0.4;
+  cv.dispatchEvent(new PointerEvent("pointerdown", {clientX: b.left + (x + 1) / 2 * b.width, clientY: b.top + (1 - y) / 2 * b.height}));
+  window.dispatchEvent(new PointerEvent("pointerup"));
+  $("viewer-test").textContent += "\n" + JSON.stringify({drag: {run: state.id, x, y, light: state.light,
+      env_rot: uniforms().env_rot, info: $("v-info").textContent, status: status.textContent}});
+}
 })();
 )JS";
 

@@ -103,7 +103,7 @@ TEST_CASE("viewer: headless Chromium renders every kind as the CPU does") {
   REQUIRE(close != std::string::npos);
   std::istringstream lines(text.substr(open, close - open));
   std::string line;
-  int runs = 0;
+  int runs = 0, drags = 0;
   register_loaders();
   const BrdfPtr original = Catalogue::global().make("bluepaint");
   SceneSettings scene;
@@ -112,6 +112,18 @@ TEST_CASE("viewer: headless Chromium renders every kind as the CPU does") {
   while (std::getline(lines, line)) {
     if (line.empty()) continue;
     const auto j = nlohmann::json::parse(line);
+    if (j.contains("drag")) {
+      // The drag through the page's handlers (point light: no environment).
+      const auto& d = j.at("drag");
+      INFO(d.dump());
+      CHECK(d.at("status").get<std::string>().empty());  // draw() ran without error
+      const Vec3 light(d.at("light")[0].get<double>(), d.at("light")[1].get<double>(), d.at("light")[2].get<double>());
+      const double dist = SceneSettings{}.light.norm();
+      CHECK((light - dist * Vec3(0.3, 0.4, std::sqrt(0.75))).norm() < 1e-3 * dist);
+      CHECK(d.at("info").get<std::string>().find("point light") != std::string::npos);
+      ++drags;
+      continue;
+    }
     const std::string id = j.at("run");
     INFO("run " << id << " " << (j.contains("error") ? j["error"].get<std::string>() : ""));
     REQUIRE(!j.contains("error"));
@@ -193,6 +205,7 @@ TEST_CASE("viewer: headless Chromium renders every kind as the CPU does") {
     }
   }
   CHECK(runs == 6);
+  CHECK(drags == 1);
 }
 
 TEST_CASE("viewer: under the scene's SH lighting the page shades as render_sphere") {
@@ -235,10 +248,31 @@ texture_size = 10
   const size_t open = text.find('>', at) + 1, close = text.find("</pre>", open);
   std::istringstream lines(text.substr(open, close - open));
   std::string line;
-  int runs = 0;
+  int runs = 0, drags = 0;
   while (std::getline(lines, line)) {
     if (line.empty()) continue;
     const auto j = nlohmann::json::parse(line);
+    if (j.contains("drag")) {
+      // The drag through the page's handlers: the light moves to
+      // |light| (0.3, 0.4, sqrt(0.75)) and the environment turns by the
+      // rotation taking the scene light's direction to it.
+      const auto& d = j.at("drag");
+      INFO(d.dump());
+      CHECK(d.at("status").get<std::string>().empty());
+      const Vec3 b = Vec3(0.3, 0.4, std::sqrt(0.75)), a = plan.scene.light.normalized();
+      const Vec3 light(d.at("light")[0].get<double>(), d.at("light")[1].get<double>(), d.at("light")[2].get<double>());
+      CHECK((light - plan.scene.light.norm() * b).norm() < 1e-3 * plan.scene.light.norm());
+      const auto rv = d.at("env_rot").get<std::vector<double>>();
+      REQUIRE(rv.size() == 9);
+      Eigen::Matrix3d R;
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c) R(r, c) = rv[3 * r + c];
+      CHECK((R * a - b).norm() < 1e-3);
+      const int degrees = int(std::lround(std::acos(a.dot(b)) * 180 / M_PI));
+      CHECK(d.at("info").get<std::string>().find("turned " + std::to_string(degrees) + " deg") != std::string::npos);
+      ++drags;
+      continue;
+    }
     INFO("run " << j.at("run").get<std::string>());
     REQUIRE(!j.contains("error"));
     REQUIRE(j.contains("approx_env"));
@@ -294,4 +328,5 @@ texture_size = 10
     CHECK(worst_t <= 2e-3 * peak_t);
   }
   CHECK(runs == 2);
+  CHECK(drags == 1);
 }
