@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "experiments/config.h"
+#include "experiments/methods/method_kind.h"
 #include "experiments/viewer.h"
 
 namespace bf {
@@ -53,14 +54,10 @@ uint64_t estimate_output_bytes(const Plan& plan, const std::vector<bool>& todo) 
     const uint64_t t = uint64_t(std::max(m.texture_size, 1));
     bytes += (uint64_t(64) << 10) + uint64_t(std::max(m.terms, 1)) * t * t * 3 * 4 * 2;
     if (sample_sets.insert(r.samples_key).second) bytes += samples_of(plan.samplings[r.sampling]) * 96;
-    // SVD / SH-K exports (float64 data + float32 EXR + the viewer's base64 copy,
-    // about 18 bytes per value) and the viewer's tabulation of the original (1 MB base64).
+    // The kind's own exports, and the viewer's tabulation of the original (1 MB base64).
     if (plan.experiment.export_factors) {
-      const uint64_t res = uint64_t(std::max(m.kind == "sh-k" ? m.shk.view_res : m.svd.res, 2));
-      const uint64_t order = uint64_t(std::max({m.shk.order, m.cap, 0}) + 1);
-      if (m.kind == "svd") bytes += uint64_t(std::max({m.svd.rank, m.terms, m.cap, 1})) * 2 * res * res * 3 * 18;
-      if (m.kind == "sh-k") bytes += order * order * res * res * 3 * 18;
-      if (plan.experiment.render && m.kind != "model-fit") {
+      bytes += m.impl->export_bytes(m);
+      if (plan.experiment.render && m.impl->has_viewer()) {
         bytes += uint64_t(kViewerTableRes) * kViewerTableRes * kViewerTableRes * kViewerTableRes * 3 * 4 * 4 / 3 +
                  (uint64_t(64) << 10);
         if (plan.scene.lighting) bytes += uint64_t(kViewerEnvWidth) * (kViewerEnvWidth / 2) * 3 * 4 * 4 / 3 + (uint64_t(64) << 10);

@@ -310,11 +310,6 @@ ExperimentOutput base_output(const Plan& plan, const std::string& dir, int shard
   return o;
 }
 
-void print_results(std::ostream& out, const OutputFiles& f) {
-  out << "results: " << f.results_md << "\n";
-  out << "report:  " << f.report << "\n";
-}
-
 // How execute_in_parallel ended: stopped_by is the signal (SIGINT/SIGTERM)
 // that stopped it, 0 when every run finished; abandon when runs were still
 // executing then (their threads are detached: the caller must end the process
@@ -499,7 +494,64 @@ std::map<std::string, std::shared_ptr<const SampleSet>> prepare_samples(const Pl
   return samples;
 }
 
+// What each run of this shard needs: cached runs' entries go to `cached`,
+// this shard's run ids and count to `sum`.
+std::vector<Action> decide_actions(const Plan& plan, const fs::path& exp_dir, const RunOptions& opt,
+                                   RunSummary& sum, std::vector<std::optional<RunEntry>>& cached) {
+  std::vector<Action> action(plan.runs.size());
+  for (size_t i = 0; i < plan.runs.size(); ++i) {
+    const PlannedRun& r = plan.runs[i];
+    if (static_cast<int>(i % opt.shards) != opt.shard - 1) {
+      action[i] = Action::OtherShard;
+      continue;
+    }
+    sum.run_ids.push_back(r.run_id);
+    ++sum.in_shard;
+    cached[i] = load_done_run(exp_dir, r.run_id);
+    if (cached[i]) action[i] = opt.force ? Action::Forced : Action::Cached;
+    else action[i] = incomplete_folder(exp_dir, r.run_id) ? Action::Redo : Action::Run;
+  }
+  return action;
+}
+
+// Marks the runs a signal stopped before they finished; returns their count.
+size_t mark_interrupted(const Plan& plan, const std::vector<size_t>& todo, int stopped_by, int shard,
+                        std::vector<RunEntry>& entries) {
+  size_t unfinished = 0;
+  for (size_t i : todo) {
+    if (!entries[i].run_id.empty()) continue;
+    ++unfinished;
+    RunEntry& e = entries[i];
+    e.run_id = plan.runs[i].run_id;
+    e.status = "interrupted";
+    e.shard = shard;
+    set_presentation(e.row, plan, plan.runs[i]);
+    e.row["status"] = "interrupted";
+    e.row["notes"] = "interrupted by " + signal_name(stopped_by) + " before it finished; the next run does it";
+    e.record = {{"run_id", e.run_id}, {"error", "interrupted"}, {"method", plan.methods[plan.runs[i].method].options}};
+  }
+  return unfinished;
+}
+
+// After the outputs are written: the error naming the first failed run.
+[[noreturn]] void throw_failed_runs(const RunSummary& sum, const std::vector<RunEntry>& runs) {
+  std::string first;
+  for (const auto& r : runs)
+    if (r.status != "ok") {
+      first = r.run_id + ": " + r.row.at("notes");
+      break;
+    }
+  throw std::runtime_error(std::to_string(sum.failed) + " of " + std::to_string(sum.in_shard) +
+                           " runs failed (first: " + first + "); they are marked in " + sum.files.results_md +
+                           " and will be redone by the next run");
+}
+
 }  // namespace
+
+void print_output_paths(std::ostream& out, const OutputFiles& f) {
+  out << "results: " << f.results_md << "\n";
+  out << "report:  " << f.report << "\n";
+}
 
 void parse_shard(const std::string& text, int& k, int& n) {
   const auto slash = text.find('/');
@@ -552,21 +604,8 @@ RunSummary run_experiment(const RunOptions& opt, std::ostream& out, std::ostream
     interrupt_scope.emplace();
   }
 
-  // Decide what each run of this shard needs.
-  std::vector<Action> action(plan.runs.size());
   std::vector<std::optional<RunEntry>> cached(plan.runs.size());
-  for (size_t i = 0; i < plan.runs.size(); ++i) {
-    const PlannedRun& r = plan.runs[i];
-    if (static_cast<int>(i % opt.shards) != opt.shard - 1) {
-      action[i] = Action::OtherShard;
-      continue;
-    }
-    sum.run_ids.push_back(r.run_id);
-    ++sum.in_shard;
-    cached[i] = load_done_run(exp_dir, r.run_id);
-    if (cached[i]) action[i] = opt.force ? Action::Forced : Action::Cached;
-    else action[i] = incomplete_folder(exp_dir, r.run_id) ? Action::Redo : Action::Run;
-  }
+  const std::vector<Action> action = decide_actions(plan, exp_dir, opt, sum, cached);
   size_t n_run = 0, n_cached = 0, n_other = 0;
   for (Action a : action) {
     if (a == Action::Cached) ++n_cached;
@@ -618,20 +657,7 @@ RunSummary run_experiment(const RunOptions& opt, std::ostream& out, std::ostream
   const auto start = Clock::now();
   const PoolEnd pool_end = execute_in_parallel(plan, todo, jobs, samples, exp_dir, build, opt, err, entries);
   const int stopped_by = pool_end.stopped_by;
-  size_t unfinished = 0;
-  if (stopped_by)
-    for (size_t i : todo)
-      if (entries[i].run_id.empty()) {
-        ++unfinished;
-        RunEntry& e = entries[i];
-        e.run_id = plan.runs[i].run_id;
-        e.status = "interrupted";
-        e.shard = opt.shard;
-        set_presentation(e.row, plan, plan.runs[i]);
-        e.row["status"] = "interrupted";
-        e.row["notes"] = "interrupted by " + signal_name(stopped_by) + " before it finished; the next run does it";
-        e.record = {{"run_id", e.run_id}, {"error", "interrupted"}, {"method", plan.methods[plan.runs[i].method].options}};
-      }
+  const size_t unfinished = stopped_by ? mark_interrupted(plan, todo, stopped_by, opt.shard, entries) : 0;
 
   ExperimentOutput o = base_output(plan, dir, opt.shard, opt.shards);
   o.plots = opt.plots && plan.experiment.plots;
@@ -666,123 +692,8 @@ RunSummary run_experiment(const RunOptions& opt, std::ostream& out, std::ostream
     }
     throw Interrupted(msg, stopped_by);
   }
-  print_results(out, sum.files);
-  if (sum.failed) {
-    std::string first;
-    for (const auto& r : o.runs)
-      if (r.status != "ok") {
-        first = r.run_id + ": " + r.row.at("notes");
-        break;
-      }
-    throw std::runtime_error(std::to_string(sum.failed) + " of " + std::to_string(sum.in_shard) +
-                             " runs failed (first: " + first + "); they are marked in " + sum.files.results_md +
-                             " and will be redone by the next run");
-  }
-  return sum;
-}
-
-RunSummary merge_experiments(const std::vector<std::string>& dirs, const std::string& out_dir, bool quiet,
-                             bool plots, std::ostream& out, std::ostream& err) {
-  if (dirs.empty()) throw std::invalid_argument("merge: expected at least one shard folder");
-  if (out_dir.empty()) throw std::invalid_argument("merge: --out: expected the folder to write");
-  std::error_code ec;
-  for (const auto& d : dirs)
-    if (fs::exists(out_dir, ec) && fs::exists(d, ec) && fs::equivalent(d, out_dir, ec))
-      throw std::invalid_argument("merge: --out " + out_dir + " is one of the shard folders; choose a new folder");
-  std::vector<ExperimentOutput> shards;
-  for (const auto& d : dirs) shards.push_back(read_experiment_manifest(d));
-  const ExperimentOutput& first = shards[0];
-  std::vector<std::string> problems;
-  std::map<int, std::string> shard_dir;
-  for (size_t i = 0; i < shards.size(); ++i) {
-    const auto& s = shards[i];
-    if (s.plan_hash != first.plan_hash)
-      problems.push_back(dirs[i] + ": plan " + s.plan_hash + " differs from " + dirs[0] + "'s " + first.plan_hash +
-                         " (shards of different configs or overrides)");
-    if (s.shards != first.shards)
-      problems.push_back(dirs[i] + ": shard count " + std::to_string(s.shards) + " differs from " + dirs[0] +
-                         "'s " + std::to_string(first.shards));
-    auto [it, fresh] = shard_dir.emplace(s.shard, dirs[i]);
-    if (!fresh)
-      problems.push_back("shard " + std::to_string(s.shard) + "/" + std::to_string(s.shards) +
-                         " given twice: " + it->second + " and " + dirs[i]);
-  }
-  if (!problems.empty()) throw std::invalid_argument("merge: " + join(problems, "; "));
-
-  // Every planned run exactly once, done.
-  std::map<std::string, std::pair<size_t, const RunEntry*>> found;
-  std::vector<std::string> duplicates, missing;
-  for (size_t i = 0; i < shards.size(); ++i)
-    for (const auto& r : shards[i].runs) {
-      if (r.status != "ok") continue;
-      auto [it, fresh] = found.emplace(r.run_id, std::make_pair(i, &r));
-      if (!fresh) duplicates.push_back(r.run_id + " (in " + dirs[it->second.first] + " and " + dirs[i] + ")");
-    }
-  for (const auto& p : first.plan) {
-    const std::string id = p.value("run_id", "");
-    auto it = found.find(id);
-    if (it == found.end()) {
-      const int k = p.value("shard", 1);
-      missing.push_back(id + " (shard " + std::to_string(k) + (shard_dir.count(k) ? ", failed or unfinished there" :
-                                                               ", no folder given") + ")");
-      continue;
-    }
-    if (!fs::exists(fs::path(dirs[it->second.first]) / "runs" / id / "DONE", ec))
-      missing.push_back(id + " (" + dirs[it->second.first] + "/runs/" + id + " has no DONE marker)");
-  }
-  std::set<std::string> planned;
-  for (const auto& p : first.plan) planned.insert(p.value("run_id", ""));
-  for (const auto& [id, where] : found)
-    if (!planned.count(id)) duplicates.push_back(id + " (in " + dirs[where.first] + " but not in the plan)");
-  if (!duplicates.empty() || !missing.empty()) {
-    std::string msg = "merge: ";
-    if (!missing.empty()) {
-      msg += std::to_string(missing.size()) + " of " + std::to_string(first.plan.size()) + " runs missing: ";
-      for (size_t i = 0; i < missing.size() && i < 10; ++i) msg += (i ? ", " : "") + missing[i];
-      if (missing.size() > 10) msg += ", ...";
-    }
-    if (!duplicates.empty()) {
-      msg += std::string(missing.empty() ? "" : "; ") + std::to_string(duplicates.size()) + " duplicated: ";
-      for (size_t i = 0; i < duplicates.size() && i < 10; ++i) msg += (i ? ", " : "") + duplicates[i];
-    }
-    throw std::invalid_argument(msg);
-  }
-
-  // Copy the run folders and write the merged folder.
-  const fs::path odir(out_dir);
-  const OutdirLock lock(out_dir, "merge");
-  fs::create_directories(odir / "runs");
-  ExperimentOutput o;
-  o.dir = out_dir;
-  o.experiment = first.experiment;
-  o.config_path = first.config_path;
-  o.config_text = first.config_text;
-  o.defines = first.defines;
-  o.plan_hash = first.plan_hash;
-  o.shard = 1;
-  o.shards = 1;
-  o.plan = first.plan;
-  o.plots = plots;
-  o.merged_from = dirs;
-  RunSummary sum;
-  sum.out_dir = out_dir;
-  sum.planned = first.plan.size();
-  for (const auto& p : first.plan) {
-    const std::string id = p.value("run_id", "");
-    const auto& [si, entry] = found.at(id);
-    const fs::path src = fs::path(dirs[si]) / "runs" / id, dst = odir / "runs" / id;
-    if (!(fs::exists(dst, ec) && fs::equivalent(src, dst, ec))) {
-      fs::remove_all(dst);
-      fs::copy(src, dst, fs::copy_options::recursive);
-    }
-    o.runs.push_back(*entry);
-    sum.run_ids.push_back(id);
-  }
-  sum.in_shard = o.runs.size();
-  sum.cached = o.runs.size();
-  if (!quiet) err << "merge: " << o.runs.size() << " runs from " << dirs.size() << " shard folders -> " << out_dir << "\n";
-  sum.files = write_experiment_outputs(o, quiet ? nullptr : &err);
-  print_results(out, sum.files);
+  print_output_paths(out, sum.files);
+  if (sum.failed) throw_failed_runs(sum, o.runs);
   return sum;
 }
 

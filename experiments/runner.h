@@ -53,6 +53,9 @@ nlohmann::json build_identity(const nlohmann::json& versions);
 // A run record's build.git_commit; "" when it has none (older runs, no git).
 std::string cached_run_commit(const nlohmann::json& record);
 
+// Prints the "results: ..." and "report: ..." lines of a written folder.
+void print_output_paths(std::ostream& out, const OutputFiles& f);
+
 // Parses "K/N" with 1 <= K <= N; throws std::invalid_argument naming --shard.
 void parse_shard(const std::string& text, int& k, int& n);
 

@@ -5,6 +5,40 @@
 
 namespace bf {
 
+namespace {
+
+// The index of the last character of the string (basic or literal, single or
+// multi-line) opening at text[i]; counts the lines it spans.
+size_t skip_string(const std::string& text, size_t i, size_t& line, size_t& line_start) {
+  const size_t n = text.size();
+  const char c = text[i];
+  const bool multi = i + 2 < n && text[i + 1] == c && text[i + 2] == c;
+  i += multi ? 3 : 1;
+  for (; i < n; ++i) {
+    if (c == '"' && text[i] == '\\') {
+      ++i;
+      if (i < n && text[i] == '\n') {
+        ++line;
+        line_start = i + 1;
+      }
+      continue;
+    }
+    if (text[i] == '\n') {
+      ++line;
+      line_start = i + 1;
+      if (!multi) break;  // malformed: the parser reports it
+      continue;
+    }
+    if (text[i] == c && (!multi || (i + 2 < n && text[i + 1] == c && text[i + 2] == c))) {
+      if (multi) i += 2;
+      break;
+    }
+  }
+  return i;
+}
+
+}  // namespace
+
 std::string toml_key_depth_problem(const std::string& text, const std::string& origin, size_t max_depth) {
   // Open arrays ('[') and inline tables ('{'), each with the table depth of
   // what sits directly inside it: the keys of an inline table start at the
@@ -57,28 +91,7 @@ std::string toml_key_depth_problem(const std::string& text, const std::string& o
     if (c == '"' || c == '\'') {  // a string (a quoted key part in key context): skipped
       if ((key_context || in_header) && !part_open)
         if (auto p = new_part(i); !p.empty()) return p;
-      const bool multi = i + 2 < n && text[i + 1] == c && text[i + 2] == c;
-      i += multi ? 3 : 1;
-      for (; i < n; ++i) {
-        if (c == '"' && text[i] == '\\') {
-          ++i;
-          if (i < n && text[i] == '\n') {
-            ++line;
-            line_start = i + 1;
-          }
-          continue;
-        }
-        if (text[i] == '\n') {
-          ++line;
-          line_start = i + 1;
-          if (!multi) break;  // malformed: the parser reports it
-          continue;
-        }
-        if (text[i] == c && (!multi || (i + 2 < n && text[i + 1] == c && text[i + 2] == c))) {
-          if (multi) i += 2;
-          break;
-        }
-      }
+      i = skip_string(text, i, line, line_start);
       continue;
     }
     if (c == ' ' || c == '\t' || c == '\r') continue;

@@ -632,6 +632,122 @@ std::string sidecar_method(const std::string& json_path) {
   return j["method"].get<std::string>();
 }
 
+namespace {
+
+// The method-specific part of an export (after the common header and data
+// block were checked): the factorization the sidecar describes.
+std::shared_ptr<Factorization> load_svd(const Reader& r, const json& j, const json& data, const std::vector<double>& values, double seconds) {
+  SvdOptions o;
+  const std::string param = r.string(j, "parameterization");
+  if (param == "wiwo") o.param = Parameterization::WiWo;
+  else if (param == "halfdiff") o.param = Parameterization::HalfDiff;
+  else r.fail("parameterization", "\"wiwo\" or \"halfdiff\"", "\"" + param + "\"");
+  o.res = int(r.integer(j, "resolution", 2, 256));
+  o.rank = int(r.integer(j, "rank", 1, 1 << 20));
+  o.log = r.boolean(j, "log");
+  o.rim_inset = r.number(j, "rim_inset", 1e-300, 0.5);
+  if (o.param == Parameterization::HalfDiff) o.extend_below_horizon = r.boolean(j, "extend_below_horizon");
+  o.float_textures = r.boolean(j, "float_textures");
+  Rgb A = Rgb::Ones();
+  if (o.log) {
+    A = r.rgb(j, "A", true);
+    o.eps = r.number(j, "eps", 1e-300, 1.0);
+    o.subtract_eps = r.boolean(j, "subtract_eps");
+  }
+  DiskGrid grid = DiskGrid::make(o.res);
+  const size_t n = grid.count(), RR = size_t(o.res) * o.res, K = size_t(o.rank);
+  if (K > n) r.fail("rank", "at most " + std::to_string(n) + " (masked texels)", std::to_string(K));
+  const json& blocks = r.member(data, "blocks", "an array");
+  size_t S = 0;
+  for (const json& b : blocks)
+    if (b.is_object() && b.contains("name") && b["name"] == "sigma" && b.contains("count") &&
+        b["count"].is_number_unsigned())
+      S = b["count"].get<size_t>() / 3;
+  if (S < K || S > n) r.fail("data.blocks sigma.count", "3 x (rank.." + std::to_string(n) + ")", std::to_string(3 * S));
+  const auto sigma = r.block(data, values, "sigma", 3 * S);
+  const auto u = r.block(data, values, "u", 3 * K * RR);
+  const auto v = r.block(data, values, "v", 3 * K * RR);
+  std::array<TruncatedSvd, 3> svd;
+  for (int c = 0; c < 3; ++c) {
+    svd[c].sigma.resize(Eigen::Index(S));
+    for (size_t k = 0; k < S; ++k) svd[c].sigma[Eigen::Index(k)] = sigma[c * S + k];
+    svd[c].U.resize(Eigen::Index(n), Eigen::Index(K));
+    svd[c].V.resize(Eigen::Index(n), Eigen::Index(K));
+    for (size_t k = 0; k < K; ++k) {
+      const size_t at = (c * K + k) * RR;
+      r.check_masked(u, at, grid, "u[" + std::to_string(c) + "][" + std::to_string(k) + "]");
+      r.check_masked(v, at, grid, "v[" + std::to_string(c) + "][" + std::to_string(k) + "]");
+      for (size_t a = 0; a < n; ++a) {
+        svd[c].U(Eigen::Index(a), Eigen::Index(k)) = u[at + grid.texels[a]];
+        svd[c].V(Eigen::Index(a), Eigen::Index(k)) = v[at + grid.texels[a]];
+      }
+    }
+  }
+  return std::make_shared<SvdFactorization>(o, std::move(grid), A, std::move(svd), seconds);
+}
+
+std::shared_ptr<Factorization> load_shk(const Reader& r, const json& j, const json& data, const std::vector<double>& values, double seconds) {
+  ShkOptions o;
+  o.order = int(r.integer(j, "order", 0, 200));
+  o.view_res = int(r.integer(j, "view_resolution", 2, 512));
+  o.reduced = r.boolean(j, "reduced");
+  o.rim_inset = r.number(j, "rim_inset", 1e-300, 0.1);
+  o.min_cos = r.number(j, "min_cos", 1e-300, 1.0);
+  o.float_textures = r.boolean(j, "float_textures");
+  const json& quad = r.member(j, "quadrature", "an object");
+  if (quad.is_object()) {
+    o.theta_nodes = int(r.integer(quad, "theta_nodes", 1, 1 << 20));
+    o.phi_nodes = int(r.integer(quad, "phi_nodes", 1, 1 << 20));
+  }
+  DiskGrid grid = DiskGrid::make(o.view_res);
+  const size_t N = size_t(sh_count(o.order)), R = size_t(o.view_res), RR = R * R;
+  std::array<Eigen::MatrixXd, 3> coeffs;
+  if (o.reduced) {
+    const auto v = r.block(data, values, "coefficients", 3 * N * R);
+    for (int c = 0; c < 3; ++c) {
+      coeffs[c].resize(Eigen::Index(N), Eigen::Index(R));
+      for (size_t i = 0; i < N; ++i)
+        for (size_t jj = 0; jj < R; ++jj) coeffs[c](Eigen::Index(i), Eigen::Index(jj)) = v[(c * N + i) * R + jj];
+    }
+  } else {
+    const auto v = r.block(data, values, "coefficients", 3 * N * RR);
+    for (int c = 0; c < 3; ++c) {
+      coeffs[c].resize(Eigen::Index(N), Eigen::Index(grid.count()));
+      for (size_t i = 0; i < N; ++i) {
+        const size_t at = (c * N + i) * RR;
+        r.check_masked(v, at, grid, "coefficients[" + std::to_string(c) + "][" + std::to_string(i) + "]");
+        for (size_t a = 0; a < grid.count(); ++a) coeffs[c](Eigen::Index(i), Eigen::Index(a)) = v[at + grid.texels[a]];
+      }
+    }
+  }
+  auto f = std::make_shared<ShkFactorization>(o, std::move(grid), std::move(coeffs), seconds);
+  if (j.contains("min_product") && j["min_product"].is_number()) f->min_product = j["min_product"].get<double>();
+  if (j.contains("negative_fraction") && j["negative_fraction"].is_number())
+    f->negative_fraction = j["negative_fraction"].get<double>();
+  return f;
+}
+
+std::shared_ptr<Factorization> load_shr(const Reader& r, const json& j, const json& data, const std::vector<double>& values, double seconds) {
+  ShrCoefficients all;
+  all.F = int(r.integer(j, "order", 0, 2000));
+  all.P = int(r.integer(j, "view_order", 0, 2000));
+  all.energy = r.rgb(j, "energy", false);
+  const double min_cos = r.number(j, "min_cos", 1e-300, 1.0);
+  const double energy_eps = j.contains("energy_eps") && j["energy_eps"].is_number() ? j["energy_eps"].get<double>() : 0.0;
+  const size_t M = shr_coefficient_count(all.F, all.P);
+  const auto rho = r.block(data, values, "rho", 3 * M);
+  for (int c = 0; c < 3; ++c) {
+    all.rho[c].assign(size_t(all.F + 1) * (all.P + 1) * (all.P + 1), 0.0);
+    size_t n = c * M;
+    for (int q = 0; q <= std::min(all.F, all.P); ++q)
+      for (int l = q; l <= all.F; ++l)
+        for (int p = q; p <= all.P; ++p) all.rho[c][all.index(l, p, q)] = rho[n++];
+  }
+  return std::make_shared<ShrFactorization>(all, all.F, all.P, min_cos, energy_eps, seconds);
+}
+
+}  // namespace
+
 std::shared_ptr<Factorization> load_baseline_export(const std::string& json_path) {
   json j;
   {
@@ -663,114 +779,9 @@ std::shared_ptr<Factorization> load_baseline_export(const std::string& json_path
   const std::vector<double> values = read_f64(data_path, json_path, size_t(nvalues));
   const double seconds = j.contains("seconds") ? r.number(j, "seconds", 0.0, 1e12) : 0.0;
 
-  if (method == "svd") {
-    SvdOptions o;
-    const std::string param = r.string(j, "parameterization");
-    if (param == "wiwo") o.param = Parameterization::WiWo;
-    else if (param == "halfdiff") o.param = Parameterization::HalfDiff;
-    else r.fail("parameterization", "\"wiwo\" or \"halfdiff\"", "\"" + param + "\"");
-    o.res = int(r.integer(j, "resolution", 2, 256));
-    o.rank = int(r.integer(j, "rank", 1, 1 << 20));
-    o.log = r.boolean(j, "log");
-    o.rim_inset = r.number(j, "rim_inset", 1e-300, 0.5);
-    if (o.param == Parameterization::HalfDiff) o.extend_below_horizon = r.boolean(j, "extend_below_horizon");
-    o.float_textures = r.boolean(j, "float_textures");
-    Rgb A = Rgb::Ones();
-    if (o.log) {
-      A = r.rgb(j, "A", true);
-      o.eps = r.number(j, "eps", 1e-300, 1.0);
-      o.subtract_eps = r.boolean(j, "subtract_eps");
-    }
-    DiskGrid grid = DiskGrid::make(o.res);
-    const size_t n = grid.count(), RR = size_t(o.res) * o.res, K = size_t(o.rank);
-    if (K > n) r.fail("rank", "at most " + std::to_string(n) + " (masked texels)", std::to_string(K));
-    const json& blocks = r.member(data, "blocks", "an array");
-    size_t S = 0;
-    for (const json& b : blocks)
-      if (b.is_object() && b.contains("name") && b["name"] == "sigma" && b.contains("count") &&
-          b["count"].is_number_unsigned())
-        S = b["count"].get<size_t>() / 3;
-    if (S < K || S > n) r.fail("data.blocks sigma.count", "3 x (rank.." + std::to_string(n) + ")", std::to_string(3 * S));
-    const auto sigma = r.block(data, values, "sigma", 3 * S);
-    const auto u = r.block(data, values, "u", 3 * K * RR);
-    const auto v = r.block(data, values, "v", 3 * K * RR);
-    std::array<TruncatedSvd, 3> svd;
-    for (int c = 0; c < 3; ++c) {
-      svd[c].sigma.resize(Eigen::Index(S));
-      for (size_t k = 0; k < S; ++k) svd[c].sigma[Eigen::Index(k)] = sigma[c * S + k];
-      svd[c].U.resize(Eigen::Index(n), Eigen::Index(K));
-      svd[c].V.resize(Eigen::Index(n), Eigen::Index(K));
-      for (size_t k = 0; k < K; ++k) {
-        const size_t at = (c * K + k) * RR;
-        r.check_masked(u, at, grid, "u[" + std::to_string(c) + "][" + std::to_string(k) + "]");
-        r.check_masked(v, at, grid, "v[" + std::to_string(c) + "][" + std::to_string(k) + "]");
-        for (size_t a = 0; a < n; ++a) {
-          svd[c].U(Eigen::Index(a), Eigen::Index(k)) = u[at + grid.texels[a]];
-          svd[c].V(Eigen::Index(a), Eigen::Index(k)) = v[at + grid.texels[a]];
-        }
-      }
-    }
-    return std::make_shared<SvdFactorization>(o, std::move(grid), A, std::move(svd), seconds);
-  }
-
-  if (method == "sh-k") {
-    ShkOptions o;
-    o.order = int(r.integer(j, "order", 0, 200));
-    o.view_res = int(r.integer(j, "view_resolution", 2, 512));
-    o.reduced = r.boolean(j, "reduced");
-    o.rim_inset = r.number(j, "rim_inset", 1e-300, 0.1);
-    o.min_cos = r.number(j, "min_cos", 1e-300, 1.0);
-    o.float_textures = r.boolean(j, "float_textures");
-    const json& quad = r.member(j, "quadrature", "an object");
-    if (quad.is_object()) {
-      o.theta_nodes = int(r.integer(quad, "theta_nodes", 1, 1 << 20));
-      o.phi_nodes = int(r.integer(quad, "phi_nodes", 1, 1 << 20));
-    }
-    DiskGrid grid = DiskGrid::make(o.view_res);
-    const size_t N = size_t(sh_count(o.order)), R = size_t(o.view_res), RR = R * R;
-    std::array<Eigen::MatrixXd, 3> coeffs;
-    if (o.reduced) {
-      const auto v = r.block(data, values, "coefficients", 3 * N * R);
-      for (int c = 0; c < 3; ++c) {
-        coeffs[c].resize(Eigen::Index(N), Eigen::Index(R));
-        for (size_t i = 0; i < N; ++i)
-          for (size_t jj = 0; jj < R; ++jj) coeffs[c](Eigen::Index(i), Eigen::Index(jj)) = v[(c * N + i) * R + jj];
-      }
-    } else {
-      const auto v = r.block(data, values, "coefficients", 3 * N * RR);
-      for (int c = 0; c < 3; ++c) {
-        coeffs[c].resize(Eigen::Index(N), Eigen::Index(grid.count()));
-        for (size_t i = 0; i < N; ++i) {
-          const size_t at = (c * N + i) * RR;
-          r.check_masked(v, at, grid, "coefficients[" + std::to_string(c) + "][" + std::to_string(i) + "]");
-          for (size_t a = 0; a < grid.count(); ++a) coeffs[c](Eigen::Index(i), Eigen::Index(a)) = v[at + grid.texels[a]];
-        }
-      }
-    }
-    auto f = std::make_shared<ShkFactorization>(o, std::move(grid), std::move(coeffs), seconds);
-    if (j.contains("min_product") && j["min_product"].is_number()) f->min_product = j["min_product"].get<double>();
-    if (j.contains("negative_fraction") && j["negative_fraction"].is_number())
-      f->negative_fraction = j["negative_fraction"].get<double>();
-    return f;
-  }
-
-  // sh-r
-  ShrCoefficients all;
-  all.F = int(r.integer(j, "order", 0, 2000));
-  all.P = int(r.integer(j, "view_order", 0, 2000));
-  all.energy = r.rgb(j, "energy", false);
-  const double min_cos = r.number(j, "min_cos", 1e-300, 1.0);
-  const double energy_eps = j.contains("energy_eps") && j["energy_eps"].is_number() ? j["energy_eps"].get<double>() : 0.0;
-  const size_t M = shr_coefficient_count(all.F, all.P);
-  const auto rho = r.block(data, values, "rho", 3 * M);
-  for (int c = 0; c < 3; ++c) {
-    all.rho[c].assign(size_t(all.F + 1) * (all.P + 1) * (all.P + 1), 0.0);
-    size_t n = c * M;
-    for (int q = 0; q <= std::min(all.F, all.P); ++q)
-      for (int l = q; l <= all.F; ++l)
-        for (int p = q; p <= all.P; ++p) all.rho[c][all.index(l, p, q)] = rho[n++];
-  }
-  return std::make_shared<ShrFactorization>(all, all.F, all.P, min_cos, energy_eps, seconds);
+  if (method == "svd") return load_svd(r, j, data, values, seconds);
+  if (method == "sh-k") return load_shk(r, j, data, values, seconds);
+  return load_shr(r, j, data, values, seconds);
 }
 
 }  // namespace bf

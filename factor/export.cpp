@@ -332,6 +332,68 @@ ExportedFiles write_factorization(const HomomorphicFactorization& f, const std::
   return files;
 }
 
+namespace {
+
+// One entry of the sidecar's "terms" (at `where`), its texture read from `folder`.
+FactorTerm read_term(const Sidecar& s, const json& tj, const std::string& where, const fs::path& folder) {
+  FactorTerm t;
+  const std::string param = s.string(tj, where, "parameterization");
+  if (param == "wiwo") {
+    t.proj.param = Parameterization::WiWo;
+  } else if (param == "halfdiff") {
+    t.proj.param = Parameterization::HalfDiff;
+  } else {
+    s.fail_text(where + ".parameterization", "\"wiwo\" or \"halfdiff\"", "\"" + param + "\"");
+  }
+  t.proj.res = int(s.integer(tj, where, "resolution", 2, 1024));
+  {
+    const std::string field = where + ".matrix";
+    const json& m = s.array(s.member(tj, where, "matrix", "a 2x4 array of numbers"), field, 2,
+                            "rows of 4 numbers (a 2x4 matrix)");
+    for (int r = 0; r < 2; ++r) {
+      const std::string rf = field + "[" + std::to_string(r) + "]";
+      const json& row = s.array(m[r], rf, 4, "numbers (a 2x4 matrix)");
+      for (int c = 0; c < 4; ++c)
+        t.proj.P(r, c) = s.number(row[c], rf + "[" + std::to_string(c) + "]", "a finite number");
+      if (t.proj.P.row(r).lpNorm<1>() == 0.0)
+        s.fail(rf, "a row with a non-zero entry", row);
+    }
+  }
+  t.reciprocal = s.boolean(tj, where, "reciprocal");
+  if (tj.contains("quaternion_pair")) {
+    const std::string field = where + ".quaternion_pair";
+    const json& q = s.array(tj["quaternion_pair"], field, 8, "numbers (S then T, each [w, x, y, z])");
+    std::array<double, 8> qp{};
+    for (int i = 0; i < 8; ++i)
+      qp[i] = s.number(q[i], field + "[" + std::to_string(i) + "]", "a finite number");
+    t.rotation = qp;
+  }
+  t.mask = projection_mask(t.proj);
+  if (tj.contains("mask_texels")) {
+    const long long n = s.integer(tj, where, "mask_texels", 0, 1024 * 1024);
+    if (size_t(n) != t.mask_count())
+      s.fail(where + ".mask_texels",
+             std::to_string(t.mask_count()) + " (the projection mask of this matrix and resolution)",
+             tj["mask_texels"]);
+  }
+  const std::string tex = s.string(tj, where, "texture");
+  if (tex.empty()) s.fail_text(where + ".texture", "a file name", "\"\"");
+  // Decided from the text alone: the message never tells whether a file
+  // outside the sidecar's folder exists.
+  if (!is_path_inside(tex))
+    s.fail_text(where + ".texture",
+                "a file name inside the sidecar's folder (relative, no '..')", quote_for_message(tex));
+  // A symbolic link inside the folder could point anywhere: refused too.
+  if (has_symlink_below(folder.string(), tex))
+    s.fail_text(where + ".texture",
+                "a file name inside the sidecar's folder (relative, no '..', not through a symbolic link)",
+                quote_for_message(tex));
+  read_texture((folder / tex).string(), where + ".texture", t);
+  return t;
+}
+
+}  // namespace
+
 std::shared_ptr<HomomorphicFactorization> load_factorization(const std::string& json_path) {
   json j;
   {
@@ -401,59 +463,7 @@ std::shared_ptr<HomomorphicFactorization> load_factorization(const std::string& 
     const std::string where = "terms[" + std::to_string(k) + "]";
     const json& tj = tjs[k];
     if (!tj.is_object()) s.fail(where, "an object", tj);
-    FactorTerm t;
-    const std::string param = s.string(tj, where, "parameterization");
-    if (param == "wiwo") {
-      t.proj.param = Parameterization::WiWo;
-    } else if (param == "halfdiff") {
-      t.proj.param = Parameterization::HalfDiff;
-    } else {
-      s.fail_text(where + ".parameterization", "\"wiwo\" or \"halfdiff\"", "\"" + param + "\"");
-    }
-    t.proj.res = int(s.integer(tj, where, "resolution", 2, 1024));
-    {
-      const std::string field = where + ".matrix";
-      const json& m = s.array(s.member(tj, where, "matrix", "a 2x4 array of numbers"), field, 2,
-                              "rows of 4 numbers (a 2x4 matrix)");
-      for (int r = 0; r < 2; ++r) {
-        const std::string rf = field + "[" + std::to_string(r) + "]";
-        const json& row = s.array(m[r], rf, 4, "numbers (a 2x4 matrix)");
-        for (int c = 0; c < 4; ++c)
-          t.proj.P(r, c) = s.number(row[c], rf + "[" + std::to_string(c) + "]", "a finite number");
-        if (t.proj.P.row(r).lpNorm<1>() == 0.0)
-          s.fail(rf, "a row with a non-zero entry", row);
-      }
-    }
-    t.reciprocal = s.boolean(tj, where, "reciprocal");
-    if (tj.contains("quaternion_pair")) {
-      const std::string field = where + ".quaternion_pair";
-      const json& q = s.array(tj["quaternion_pair"], field, 8, "numbers (S then T, each [w, x, y, z])");
-      std::array<double, 8> qp{};
-      for (int i = 0; i < 8; ++i)
-        qp[i] = s.number(q[i], field + "[" + std::to_string(i) + "]", "a finite number");
-      t.rotation = qp;
-    }
-    t.mask = projection_mask(t.proj);
-    if (tj.contains("mask_texels")) {
-      const long long n = s.integer(tj, where, "mask_texels", 0, 1024 * 1024);
-      if (size_t(n) != t.mask_count())
-        s.fail(where + ".mask_texels",
-               std::to_string(t.mask_count()) + " (the projection mask of this matrix and resolution)",
-               tj["mask_texels"]);
-    }
-    const std::string tex = s.string(tj, where, "texture");
-    if (tex.empty()) s.fail_text(where + ".texture", "a file name", "\"\"");
-    // Decided from the text alone: the message never tells whether a file
-    // outside the sidecar's folder exists.
-    if (!is_path_inside(tex))
-      s.fail_text(where + ".texture",
-                  "a file name inside the sidecar's folder (relative, no '..')", quote_for_message(tex));
-    // A symbolic link inside the folder could point anywhere: refused too.
-    if (has_symlink_below(folder.string(), tex))
-      s.fail_text(where + ".texture",
-                  "a file name inside the sidecar's folder (relative, no '..', not through a symbolic link)",
-                  quote_for_message(tex));
-    read_texture((folder / tex).string(), where + ".texture", t);
+    FactorTerm t = read_term(s, tj, where, folder);
     terms.push_back(std::move(t));
   }
   return std::make_shared<HomomorphicFactorization>(std::move(terms), A, eps, subtract_eps, method);

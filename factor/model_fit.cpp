@@ -627,18 +627,14 @@ double ModelFitResult::parameter(const std::string& name) const {
   throw std::out_of_range("model fit: no fitted parameter '" + name + "' in " + model);
 }
 
-ModelFitResult fit_model(const SampleSet& s, const ModelFitOptions& opt) {
-  const auto t0 = std::chrono::steady_clock::now();
-  opt.validate();
-  const ModelSpec m = parse_model(opt);
-  const Metric metric = opt.metric == "log" ? Metric::Log
-                        : opt.cube_root      ? Metric::CubeRoot
-                                             : Metric::Cosine;
-  const LogTransform t = LogTransform::of(s, opt.eps);  // throws for no valid sample / zero channel
+namespace {
 
+// The valid samples in the form the residuals read: geometry, values, the
+// metric's targets and the square roots of the normalized weights.
+FitSamples fit_samples(const SampleSet& s, const LogTransform& t, Metric metric, double eps) {
   FitSamples d;
   d.A = t.A;
-  d.eps = opt.eps;
+  d.eps = eps;
   double W = 0;
   for (size_t k = 0; k < s.size(); ++k)
     if (s.valid[k]) W += s.weight_of(k);
@@ -659,6 +655,21 @@ ModelFitResult fit_model(const SampleSet& s, const ModelFitOptions& opt) {
     d.sw.push_back(std::sqrt(s.weight_of(k) / (3.0 * W)));
     d.target.push_back(target);
   }
+  return d;
+}
+
+}  // namespace
+
+ModelFitResult fit_model(const SampleSet& s, const ModelFitOptions& opt) {
+  const auto t0 = std::chrono::steady_clock::now();
+  opt.validate();
+  const ModelSpec m = parse_model(opt);
+  const Metric metric = opt.metric == "log" ? Metric::Log
+                        : opt.cube_root      ? Metric::CubeRoot
+                                             : Metric::Cosine;
+  const LogTransform t = LogTransform::of(s, opt.eps);  // throws for no valid sample / zero channel
+
+  const FitSamples d = fit_samples(s, t, metric, opt.eps);
 
   const size_t P = m.params.size();
   std::vector<double> u(P);

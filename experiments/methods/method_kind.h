@@ -108,6 +108,16 @@ class MethodKind {
   virtual void extra_outputs(const RunContext& c, MethodOutcome& out, Row& row) const {
     (void)c, (void)out, (void)row;
   }
+  // Bytes export_files writes beyond the common estimate (textures of
+  // texture_size per term, factorization.json): the preflight's disk estimate
+  // (experiments/preflight.h).
+  virtual uint64_t export_bytes(const MethodVariant& m) const {
+    (void)m;
+    return 0;
+  }
+  // Whether report.html's viewer shows runs of this kind (a tabulation of the
+  // original is then written beside the run, counted by the preflight).
+  virtual bool has_viewer() const { return true; }
 };
 
 // The registered kinds, in registration order (the order of messages and docs).

@@ -90,6 +90,12 @@ class ShkKind final : public MethodKind {
   }
 
   void export_files(const RunContext& c, const MethodOutcome& out) const override { export_tabulated(c, out); }
+  // Float64 data + float32 EXR + the viewer's base64 copy: about 18 bytes per value.
+  uint64_t export_bytes(const MethodVariant& m) const override {
+    const uint64_t res = uint64_t(std::max(m.shk.view_res, 2));
+    const uint64_t order = uint64_t(std::max({m.shk.order, m.cap, 0}) + 1);
+    return order * order * res * res * 3 * 18;
+  }
   MethodOutcome run(const RunContext& c) const override {
     const MethodVariant& m = c.method;
     // An isotropic BRDF (by the azimuthal-invariance test) is stored along phi_v = 0 only.

@@ -2,6 +2,8 @@
 // (wi, wo) or (h, d) and truncated to rank K per channel
 // (factor/svd_baseline.h); with a tolerance the smallest rank (and with
 // texture_size = "auto" the resolution) reaching the target.
+#include <algorithm>
+
 #include "experiments/methods/tabulating.h"
 #include "factor/svd_baseline.h"
 #include "solvers/parallel.h"
@@ -99,6 +101,11 @@ class SvdKind final : public MethodKind {
   }
 
   void export_files(const RunContext& c, const MethodOutcome& out) const override { export_tabulated(c, out); }
+  // Float64 data + float32 EXR + the viewer's base64 copy: about 18 bytes per value.
+  uint64_t export_bytes(const MethodVariant& m) const override {
+    const uint64_t res = uint64_t(std::max(m.svd.res, 2));
+    return uint64_t(std::max({m.svd.rank, m.terms, m.cap, 1})) * 2 * res * res * 3 * 18;
+  }
   MethodOutcome run(const RunContext& c) const override {
     const MethodVariant& m = c.method;
     MethodOutcome out;
