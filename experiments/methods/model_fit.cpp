@@ -118,8 +118,6 @@ class ModelFitKind final : public MethodKind {
     row["model"] = std::dynamic_pointer_cast<const ModelFitFactorization>(out.result)->result().spec;
   }
 
-  bool has_viewer() const override { return false; }
-
   void export_files(const RunContext& c, const MethodOutcome& out) const override {
     const auto mf = std::dynamic_pointer_cast<const ModelFitFactorization>(out.result);
     write_model_fit(mf->result(), (c.run_dir / "model.json").string());

@@ -1,6 +1,7 @@
 // Every registered method kind exports what a renderer needs: its run's
 // export reloads through --brdf and scores the run's own metrics, and its
-// GLSL compiles for GL 3.3, GL 4.5, GLES 3.0 and Vulkan. A kind added
+// GLSL compiles for GL 3.3, GL 4.5, GLES 3.0 and Vulkan, and it has viewer
+// data for report.html when it says it has (has_viewer). A kind added
 // without an export fails here. (Pointwise checks per kind: the reload
 // against the in-memory factorization in tests/factor/export_test.cpp,
 // baseline_export_test.cpp and model_glsl_test.cpp.)
@@ -24,8 +25,10 @@ TEST_CASE("export: every kind's export reloads with its run's metrics and its GL
     ScratchDir tmp;
     const std::string cfg = write_text(tmp / "cfg.toml", R"([experiment]
 name = "t"
-render = false
 plots = false
+
+[scene]
+size = 16
 
 [[brdf]]
 preset = "bluepaint"
@@ -54,6 +57,9 @@ kind = ")" + kind->name() + "\"\n" + kind->example());
       INFO(name << ": run " << want << ", reloaded export " << got);
       CHECK(std::abs(got - want) <= 1e-6 * std::abs(want));
     }
+    // The report's viewer data exists exactly for the kinds that declare a
+    // viewer (the preflight counts its bytes by has_viewer()).
+    CHECK(fs::exists(run / "viewer.js") == kind->has_viewer());
     const fs::path glsl = run / (model ? "model.glsl" : "factors.glsl");
     REQUIRE(fs::exists(glsl));
     const std::string err = compile_glsl_all_targets(read_text(glsl.string()), tmp.path,
