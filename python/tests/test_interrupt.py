@@ -83,6 +83,7 @@ def test_ctrl_c_interrupts_a_refinement(grid12):
     start = bf.mccool(grid12, texture_size=64)
     latency = interrupt(lambda: bf.refine(start, grid12, objective="blend", max_iterations=100000,
                                           function_tolerance=1e-300, threads=1))
+    print("refine: KeyboardInterrupt %.3f s after SIGINT" % latency)
     assert latency < BOUND
 
 
@@ -95,6 +96,7 @@ def test_ctrl_c_interrupts_an_experiment(tmp_path):
                    '[[method]]\nkind = "mccool"\ntexture_size = 8\n')
     out = tmp_path / "out"
     latency = interrupt(lambda: bf.run(cfg, out=out))
+    print("bf.run: KeyboardInterrupt %.3f s after SIGINT" % latency)
     assert latency < BOUND
     # The runner wrote its tables: the run that finished, the others marked interrupted.
     rows = bf.results(out)
