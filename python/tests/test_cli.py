@@ -194,6 +194,8 @@ BAD_OPTIONS = [
      dict(texture_size="auto", tolerance=("rel_mze", 0.1))),
     ("fit", 'projections = [{ name = "x" }, { matrix = [[1, 0, 0, 0], [1, 0, 0, 0]] }]',
      dict(projections=["x", np.array([[1, 0, 0, 0], [1, 0, 0, 0]])])),
+    ("fit", 'projections = [{ name = "wi", matrix = [[1, 0, 0, 0], [0, 1, 0, 0]] }]',
+     dict(projections=[{"name": "wi", "matrix": np.eye(2, 4)}])),
     ("sh-r", "order = 4", dict(order=4)),
     ("sh-k", "reduce_isotropic = 1.5", dict(reduce_isotropic=1.5)),
     ("model-fit", "restarts = 2", dict(restarts=2)),

@@ -51,6 +51,10 @@ def test_fit_with_named_matrix_and_dict_projections(grid8):
     assert len(one.errors_after_term) == 1 and one.metrics["rel_mse"] >= a.metrics["rel_mse"]
     with pytest.raises(ValueError, match=r"^fit: projections\[0\].matrix: .*rows must be orthonormal"):
         bf.fit(grid8, projections=[[[1, 1, 0, 0], [0, 1, 0, 0]]])
+    # Both alternatives given: one problem, stated once.
+    with pytest.raises(ValueError) as e:
+        bf.fit(grid8, projections=[{"name": "wi", "matrix": np.eye(2, 4)}], texture_size=8)
+    assert str(e.value) == "fit: projections[0].name: matrix and name are alternatives: give one of them, found both"
     with pytest.raises(ValueError, match=r"^fit: terms: terms = 3 but only 2 projections are given"):
         bf.fit(grid8, projections=["wi", "wo"], terms=3)
 
