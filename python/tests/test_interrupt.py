@@ -20,6 +20,16 @@ DELAY = 0.5   # seconds from the call's start to SIGINT
 BOUND = 3.0   # seconds from SIGINT to KeyboardInterrupt (a loaded 2-core machine)
 
 
+@pytest.fixture(autouse=True)
+def python_handles_sigint():
+    """Python's own SIGINT handler, as in an interactive session: a test run
+    started in the background by a non-interactive shell inherits SIGINT
+    ignored, and then nothing (rightly) reacts to it."""
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    yield
+    signal.signal(signal.SIGINT, previous)
+
+
 def interrupt(call):
     """Runs call(), sends SIGINT to the process after DELAY seconds, and
     returns the seconds from the signal to the KeyboardInterrupt."""
