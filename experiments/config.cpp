@@ -568,10 +568,8 @@ void read_methods(const toml::node* node, Ctx& ctx, uint64_t base_seed, std::vec
       }
       const MethodKind* kind = find_method_kind(r.choice("kind", "", kinds));
       if (r.failed() || !kind) continue;
-      reject_other_kinds_keys(r, *kind);
       MethodVariant m;
-      m.where = r.table_where();
-      read_method(r, *kind, base_seed, m);
+      read_method_table(r, *kind, base_seed, m);
       if (r.failed()) continue;
       out.push_back(std::move(m));
     }
@@ -686,6 +684,18 @@ Plan parse_plan(const std::string& text, const std::string& path, const std::vec
 
 Plan load_plan(const std::string& path, const std::vector<std::string>& defines) {
   return parse_plan(read_regular_file(path, kMaxTextFileBytes, "config"), path, defines);
+}
+
+// ------------------------------------------------------------------ one table, for other readers
+
+void read_method_table(Reader& r, const MethodKind& kind, uint64_t base_seed, MethodVariant& m) {
+  reject_other_kinds_keys(r, kind);
+  m.where = r.table_where();
+  read_method(r, kind, base_seed, m);
+}
+
+ExperimentSettings read_experiment_table(const toml::table& t, Ctx& ctx, const std::string& path) {
+  return read_experiment(&t, ctx, path);
 }
 
 }  // namespace bf

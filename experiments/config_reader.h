@@ -153,6 +153,15 @@ class Reader {
 void report_invalid(Reader& r, const std::exception& e, const std::vector<std::string>& keys,
                     const std::string& prefix = "", const std::map<std::string, std::string>& renames = {});
 
+// One [[method]] table of kind `kind` (one combination of its sweeps), read as
+// the config reader reads each: other kinds' keys refused, the common keys,
+// the kind's own (experiments/methods/), unknown keys. Problems go to r. The
+// Python module reads a method's keyword arguments through it.
+void read_method_table(Reader& r, const MethodKind& kind, uint64_t base_seed, MethodVariant& m);
+// The [experiment] table as the config reader reads it (problems go to ctx;
+// path names the config: the default name and out).
+ExperimentSettings read_experiment_table(const toml::table& t, Ctx& ctx, const std::string& path);
+
 // Keys shared by several method kinds.
 Parameterization read_param(Reader& r, const std::string& key, Parameterization def);
 // texture_size: an integer lo..hi, or "auto": the resolution is then chosen by

@@ -6,16 +6,20 @@
 
 #include <atomic>
 
+#include "solvers/cancel.h"
+
 namespace bf {
 
 namespace {
 
 std::atomic<int> g_signal{0};
+std::atomic<bool> g_cancel_work{false};
 struct sigaction g_old_int, g_old_term;
 
 extern "C" void on_signal(int sig) {
   int expected = 0;
   if (g_signal.compare_exchange_strong(expected, sig)) {
+    if (g_cancel_work.load()) request_cancel();
     static const char msg[] =
         "brdf-factor: interrupted: no new run starts; writing the finished runs (signal again to stop at once)\n";
     const ssize_t w = ::write(STDERR_FILENO, msg, sizeof msg - 1);
@@ -29,8 +33,10 @@ extern "C" void on_signal(int sig) {
 
 }  // namespace
 
-InterruptScope::InterruptScope() {
+InterruptScope::InterruptScope(bool cancel_work) {
   g_signal = 0;
+  g_cancel_work = cancel_work;
+  if (cancel_work) clear_cancel();
   struct sigaction sa {};
   sa.sa_handler = on_signal;
   sigemptyset(&sa.sa_mask);
@@ -42,6 +48,7 @@ InterruptScope::InterruptScope() {
 InterruptScope::~InterruptScope() {
   ::sigaction(SIGINT, &g_old_int, nullptr);
   ::sigaction(SIGTERM, &g_old_term, nullptr);
+  if (g_cancel_work.exchange(false)) clear_cancel();
 }
 
 int interrupt_signal() { return g_signal.load(); }

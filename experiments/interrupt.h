@@ -10,9 +10,12 @@
 namespace bf {
 
 // Installs the handlers for its lifetime (restoring the previous ones after).
+// cancel_work: the first signal also requests the cancellation of the
+// computations in progress (solvers/cancel.h); the request is withdrawn when
+// the scope ends.
 class InterruptScope {
  public:
-  InterruptScope();
+  explicit InterruptScope(bool cancel_work = false);
   ~InterruptScope();
   InterruptScope(const InterruptScope&) = delete;
   InterruptScope& operator=(const InterruptScope&) = delete;

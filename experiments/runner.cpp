@@ -31,6 +31,7 @@
 #include "experiments/preflight.h"
 #include "experiments/methods/method_kind.h"
 #include "experiments/viewer.h"
+#include "solvers/cancel.h"
 #include "factor/isotropy.h"
 #include "factor/metrics.h"
 #include "solvers/parallel.h"
@@ -373,13 +374,17 @@ PoolEnd execute_in_parallel(const Plan& plan, const std::vector<size_t>& todo, i
         std::error_code ec;
         fs::remove_all(exp_dir / "runs" / r.run_id, ec);
         e = RunEntry{};
-        e.run_id = r.run_id;
-        e.status = "failed";
-        set_presentation(e.row, plan, r);
-        e.row["status"] = "failed";
-        const bool oom = dynamic_cast<const std::bad_alloc*>(&ex) != nullptr;  // never "std::bad_alloc" alone
-        e.row["notes"] = std::string("failed: ") + (oom ? "out of memory" : ex.what());
-        e.record = {{"run_id", r.run_id}, {"error", ex.what()}, {"method", plan.methods[r.method].options}};
+        // Cancelled by a signal (RunOptions::cancel_on_signal): left empty, so
+        // marked interrupted below with the runs not started.
+        if (!(dynamic_cast<const Cancelled*>(&ex) && interrupt_signal())) {
+          e.run_id = r.run_id;
+          e.status = "failed";
+          set_presentation(e.row, plan, r);
+          e.row["status"] = "failed";
+          const bool oom = dynamic_cast<const std::bad_alloc*>(&ex) != nullptr;  // never "std::bad_alloc" alone
+          e.row["notes"] = std::string("failed: ") + (oom ? "out of memory" : ex.what());
+          e.record = {{"run_id", r.run_id}, {"error", ex.what()}, {"method", plan.methods[r.method].options}};
+        }
       }
       e.shard = opt.shard;
       {
@@ -420,7 +425,7 @@ PoolEnd execute_in_parallel(const Plan& plan, const std::vector<size_t>& todo, i
     end.stopped_by = st->exited < n_threads || st->done < total ? interrupt_signal() : 0;
     if (end.stopped_by) {
       st->cv.notify_all();  // idle workers see the signal and return
-      end.abandon = st->busy > 0;
+      end.abandon = st->busy > 0 && !cancel_requested();  // cancelled runs end soon: wait
       if (!end.abandon)
         while (st->exited < n_threads) st->cv.wait_for(lk, std::chrono::milliseconds(100));
     }
@@ -601,7 +606,7 @@ RunSummary run_experiment(const RunOptions& opt, std::ostream& out, std::ostream
   std::optional<InterruptScope> interrupt_scope;  // SIGINT/SIGTERM stop cleanly (experiments/interrupt.h)
   if (!opt.dry_run) {
     lock.emplace(dir, "run " + opt.config);
-    interrupt_scope.emplace();
+    interrupt_scope.emplace(opt.cancel_on_signal);
   }
 
   std::vector<std::optional<RunEntry>> cached(plan.runs.size());

@@ -31,6 +31,10 @@ struct RunOptions {
   int shard = 1, shards = 1;         // execute run i (0-based, plan order) iff i % shards == shard - 1
   int jobs = -1;                     // runs at once; -1 = experiment.jobs; 0 = hardware threads
   bool plots = true;                 // false: skip plot_results.py (--no-plots)
+  // The first SIGINT/SIGTERM also cancels the runs in progress (solvers/cancel.h)
+  // instead of letting them finish; they are marked interrupted like the runs
+  // not started. For callers that cannot wait (the Python module's Ctrl-C).
+  bool cancel_on_signal = false;
 };
 
 struct RunSummary {

@@ -1,5 +1,6 @@
 // Homomorphic least-squares fit (see homomorphic_fit.h for the formulation).
 #include "factor/homomorphic_fit.h"
+#include "solvers/cancel.h"
 #include "solvers/option_error.h"
 
 #include <Eigen/Cholesky>
@@ -314,6 +315,7 @@ size_t JointPrefix::terms() const { return impl_->known.size(); }
 JointSolution solve_joint(const FitData& d, const std::array<std::vector<double>, 3>& fixed_values,
                           const std::vector<TermSpec>& joint, const FitOptions& opt,
                           bool exact_error, const JointPrefix* prefix) {
+  check_cancel();  // every fit and every search evaluation is a joint solve
   opt.validate();
   if (joint.empty()) throw std::invalid_argument("fit: no terms to solve");
   const size_t N = d.size();

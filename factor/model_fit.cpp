@@ -19,7 +19,7 @@
 #include <stdexcept>
 #include <thread>
 
-#include "solvers/option_error.h"
+#include "factor/ceres_cancel.h"
 #include "brdfs/catalogue.h"
 #include "brdfs/models.h"
 #include "brdfs/params.h"
@@ -692,6 +692,8 @@ ModelFitResult fit_model(const SampleSet& s, const ModelFitOptions& opt) {
   so.parameter_tolerance = 1e-10;
   so.num_threads = hardware_threads(opt.threads);
   so.logging_type = ceres::SILENT;
+  CeresCancelCallback cancel;
+  so.callbacks.push_back(&cancel);
 
   ModelFitResult res;
   res.model = m.name;
@@ -722,6 +724,7 @@ ModelFitResult fit_model(const SampleSet& s, const ModelFitOptions& opt) {
     for (size_t i = 0; i < P; ++i) u[i] = to_free(m.params[i], p[i]);
     ceres::Solver::Summary summary;
     ceres::Solve(so, &problem, &summary);
+    check_cancel();  // an aborted solve is no result
     res.iterations += summary.num_successful_steps + summary.num_unsuccessful_steps;
     // The cost at the parameters Ceres leaves (its last accepted point), also
     // after a FAILURE such as a non-finite Jacobian at that point.

@@ -1,5 +1,6 @@
 // Nonlinear refinement of homomorphic factorizations with Ceres (see refine.h).
 #include "factor/refine.h"
+#include "factor/ceres_cancel.h"
 #include "solvers/option_error.h"
 #include "solvers/parallel.h"
 
@@ -307,8 +308,11 @@ std::shared_ptr<HomomorphicFactorization> refine(const HomomorphicFactorization&
   so.num_threads = hardware_threads(opt.threads);
   so.logging_type = ceres::SILENT;
   so.minimizer_progress_to_stdout = false;
+  CeresCancelCallback cancel;
+  so.callbacks.push_back(&cancel);
   ceres::Solver::Summary summary;
   ceres::Solve(so, &problem, &summary);
+  check_cancel();  // an aborted solve is no result
   if (summary.termination_type == ceres::FAILURE ||
       !std::all_of(y.begin(), y.end(), [](double v) { return std::isfinite(v); }))
     throw std::runtime_error("refine: Ceres failed: " + summary.message);

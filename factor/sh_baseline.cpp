@@ -17,6 +17,7 @@
 #include "solvers/quadrature.h"
 #include "solvers/sh.h"
 #include "solvers/sh_rotation.h"
+#include "solvers/cancel.h"
 #include "solvers/option_error.h"
 
 namespace bf {
@@ -246,6 +247,7 @@ std::shared_ptr<ShkFactorization> fit_shk(const Brdf& brdf, const ShkOptions& op
     Eigen::MatrixXd Fm(Nq, 3 * chunk);
     double local_min = std::numeric_limits<double>::infinity(), local_neg = 0, local_checked = 0;
     for (int64_t kc = k0; kc < k1; ++kc) {
+      check_cancel();
       const Eigen::Index t0v = Eigen::Index(kc) * chunk;
       const Eigen::Index nb = std::min(chunk, T - t0v);
       std::vector<uint8_t> inside(nb);
@@ -433,6 +435,7 @@ ShrCoefficients shr_coefficients(const Brdf& brdf, const ShrOptions& opt) {
     std::vector<double> vals(3 * size_t(nphi));
     Rgb local_energy = Rgb::Zero();
     for (int o = int(o0); o < int(o1); ++o) {
+      check_cancel();
       const double cto = go.x[o];
       const double half_c = std::sqrt(0.5 * (1.0 + cto)), half_s = std::sqrt(0.5 * (1.0 - cto));
       for (int i = 0; i < ni; ++i) {

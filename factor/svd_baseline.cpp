@@ -12,6 +12,7 @@
 #include "factor/metrics.h"
 #include "factor/projection.h"
 #include "solvers/parallel.h"
+#include "solvers/cancel.h"
 #include "solvers/option_error.h"
 
 namespace bf {
@@ -121,7 +122,8 @@ SvdTable tabulate_svd(const Brdf& brdf, const SvdOptions& opt) {
   parallel_for(n, [&](int64_t c0, int64_t c1) {
     Rgb local_sum = Rgb::Zero();
     double local_count = 0;
-    for (int c = int(c0); c < int(c1); ++c)
+    for (int c = int(c0); c < int(c1); ++c) {
+      check_cancel();
       for (int r = 0; r < n; ++r) {
         Vec3 wi = dir[r], wo = dir[c];
         if (opt.param == Parameterization::HalfDiff) half_diff_inverse(dir[r], dir[c], wi, wo);
@@ -145,6 +147,7 @@ SvdTable tabulate_svd(const Brdf& brdf, const SvdOptions& opt) {
         }
         for (int ch = 0; ch < 3; ++ch) t.M[ch](r, c) = f[ch];
       }
+    }
     std::lock_guard<std::mutex> lock(sum_mutex);
     sum += local_sum;
     count += local_count;
@@ -324,7 +327,11 @@ std::shared_ptr<SvdFactorization> fit_svd(const SvdTable& table, const SvdOption
   }
   const auto t0 = std::chrono::steady_clock::now();
   std::array<TruncatedSvd, 3> s;
-  for (int c = 0; c < 3; ++c) s[c] = truncated_svd(table.M[c], opt.rank);
+  for (int c = 0; c < 3; ++c) {
+    check_cancel();  // one decomposition (seconds at large sizes) per channel
+    s[c] = truncated_svd(table.M[c], opt.rank);
+  }
+  check_cancel();
   return std::make_shared<SvdFactorization>(opt, table.grid, table.A, std::move(s),
                                             table.seconds + seconds_since(t0));
 }

@@ -1,5 +1,6 @@
 // Greedy projection search (see term_search.h).
 #include "search/term_search.h"
+#include "solvers/cancel.h"
 #include "solvers/option_error.h"
 #include "solvers/parallel.h"
 
@@ -180,6 +181,9 @@ StartResult nlopt_minimize(const RotationObjective& f, const Rotation4& start,
     o.optimize(a, fv);
   } catch (const nlopt::roundoff_limited&) {
   } catch (const nlopt::forced_stop&) {
+  } catch (const std::runtime_error&) {
+    check_cancel();  // nlopt reports a Cancelled thrown by the objective as "nlopt failure"
+    throw;
   }
   StartResult r;
   r.best = chart(start, a.data());

@@ -49,10 +49,13 @@ void read_projections(Reader& r, MethodVariant& m, json& o) {
     Mat24 P = Mat24::Zero();
     std::string name;
     if (pr.has("matrix") == pr.has("name")) {
-      if (pr.has("matrix"))
+      if (pr.has("matrix")) {
         pr.fail("name", "matrix and name are alternatives: give one of them, found both");
-      else
+        pr.take("matrix");  // reported above: not unknown keys besides
+        pr.take("name");
+      } else {
         pr.fail_table("expected matrix = [[4 numbers], [4 numbers]] or name = \"wi\" | \"wo\" | \"h\" | \"d\"");
+      }
     } else if (pr.has("name")) {
       name = pr.choice("name", "wi", {"wi", "wo", "h", "d"});
       const Parameterization implied = (name == "wi" || name == "wo") ? Parameterization::WiWo

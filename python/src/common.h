@@ -1,6 +1,6 @@
 // Shared pieces of the Python module brdf_factor._core: the wrapped BRDF and
-// factorization objects, numpy conversions, keyword-option reading with the
-// configs' rules, and Ctrl-C handling around long calls.
+// factorization objects, numpy conversions, and long calls (GIL released,
+// Ctrl-C cancels).
 #pragma once
 
 #include <pybind11/numpy.h>
@@ -48,14 +48,24 @@ struct PyFactorization : PyBrdf {
 // The Python object of a factorization (no report yet).
 std::shared_ptr<PyFactorization> wrap(FactorizationPtr f);
 
-// Raised (as KeyboardInterrupt) when Ctrl-C arrives during a long call that can notice it.
-struct Interrupted : std::exception {
-  const char* what() const noexcept override { return "interrupted"; }
+// A long call (a method, a refinement, an experiment run): constructed with
+// the GIL held, it releases the GIL for its lifetime. Called from Python's
+// main thread (where Python runs signal handlers), it also makes Ctrl-C
+// cancel the computation: SIGINT requests a cancellation (solvers/cancel.h)
+// and is passed on to the handler Python installed, so the call ends with
+// bf::Cancelled at its next cancellation point, which the module raises as
+// KeyboardInterrupt (or whatever Python's SIGINT handler raises).
+class LongCall {
+ public:
+  LongCall();
+  ~LongCall();
+  LongCall(const LongCall&) = delete;
+  LongCall& operator=(const LongCall&) = delete;
+
+ private:
+  bool chained_ = false;
+  std::optional<py::gil_scoped_release> release_;
 };
-// With the GIL released: takes it, runs pending Python signal handlers, and
-// throws Interrupted if one raised (Ctrl-C). Call only from the thread that
-// released the GIL.
-void check_signals();
 
 // nlohmann::json <-> Python objects (through the json module: small documents only).
 py::object to_python(const nlohmann::json& j);
@@ -70,51 +80,6 @@ py::array_t<double, py::array::c_style | py::array::forcecast> directions_array(
 // (N, 3) views into the vectors (Eigen's 3-vectors are 3 packed doubles).
 static_assert(sizeof(Vec3) == 3 * sizeof(double) && sizeof(Rgb) == 3 * sizeof(double),
               "SampleSet arrays are exposed as (N, 3) views");
-
-// Keyword options of one method, read into an options struct by name. Types
-// are checked here ("<kind>: <key>: expected ..., found ..."); ranges and rules
-// are the structs' validate(), as in the configs. finish() rejects every key
-// not read, naming it (with a close accepted key, if any).
-class Options {
- public:
-  Options(std::string kind, const py::kwargs& kw);
-  bool has(const std::string& key) const { return values_.count(key) > 0; }
-  // Ranges are the config reader's (experiments/config.cpp), worded as it
-  // words them ("expected an integer in 1..64, found 0", "expected a number
-  // >= 0, found -1"), so a range violation reads as in the CLI's message.
-  static constexpr long long kNoLimit = std::numeric_limits<long long>::max();
-  int integer(const std::string& key, int def, long long lo = -kNoLimit, long long hi = kNoLimit);
-  uint64_t seed(const std::string& key, uint64_t def);
-  double number(const std::string& key, double def, double lo = -std::numeric_limits<double>::infinity(),
-                double hi = std::numeric_limits<double>::infinity(), bool lo_open = false);
-  bool boolean(const std::string& key, bool def);
-  std::string text(const std::string& key, const std::string& def);
-  std::string choice(const std::string& key, const std::string& def, const std::vector<std::string>& allowed);
-  std::vector<std::string> texts(const std::string& key);
-  py::object object(const std::string& key);  // None when absent
-  // Throws std::invalid_argument listing the unknown keys.
-  void finish();
-  // Throws std::invalid_argument "<kind>: <message>" (for a validate() failure).
-  [[noreturn]] void fail(const std::string& message) const;
-  const std::string& kind() const { return kind_; }
-
- private:
-  py::object take(const std::string& key);
-  [[noreturn]] void type_error(const std::string& key, const std::string& expected, const py::handle& found) const;
-  std::string kind_;
-  std::map<std::string, py::object> values_;
-  std::vector<std::string> read_;
-};
-
-// Calls f (a validate()) and rethrows its std::invalid_argument prefixed with "<kind>: ".
-template <class F>
-void validated(const Options& o, F&& f) {
-  try {
-    f();
-  } catch (const std::invalid_argument& e) {
-    o.fail(e.what());
-  }
-}
 
 // Binding groups, one per source file.
 void bind_catalogue(py::module_& m);     // catalogue.cpp: Brdf, models, presets, brdf()

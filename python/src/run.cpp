@@ -23,10 +23,13 @@ void bind_run(py::module_& m) {
         parse_shard(shard, o.shard, o.shards);
         o.jobs = jobs;
         o.plots = plots;
+        // Ctrl-C cancels the runs in progress too (a notebook cannot wait for
+        // them); bf::Interrupted then raises KeyboardInterrupt.
+        o.cancel_on_signal = true;
         std::ostringstream listing;
         RunSummary s;
         {
-          py::gil_scoped_release release;
+          LongCall long_call;
           s = run_experiment(o, listing, std::cerr);
         }
         py::dict files;

@@ -51,6 +51,10 @@ def test_fit_with_named_matrix_and_dict_projections(grid8):
     assert len(one.errors_after_term) == 1 and one.metrics["rel_mse"] >= a.metrics["rel_mse"]
     with pytest.raises(ValueError, match=r"^fit: projections\[0\].matrix: .*rows must be orthonormal"):
         bf.fit(grid8, projections=[[[1, 1, 0, 0], [0, 1, 0, 0]]])
+    # Both alternatives given: one problem, stated once.
+    with pytest.raises(ValueError) as e:
+        bf.fit(grid8, projections=[{"name": "wi", "matrix": np.eye(2, 4)}], texture_size=8)
+    assert str(e.value) == "fit: projections[0].name: matrix and name are alternatives: give one of them, found both"
     with pytest.raises(ValueError, match=r"^fit: terms: terms = 3 but only 2 projections are given"):
         bf.fit(grid8, projections=["wi", "wo"], terms=3)
 
@@ -101,7 +105,7 @@ def test_model_fit_recovers_planted_parameters():
     s = bf.sample_grid(b, 8)
     f = bf.model_fit(s, model="ward", starts=2, threads=1)
     check_report(f, s, "model-fit")
-    p = f.info["parameters"]
+    p = f.info["model_fit"]["parameters"]
     assert p["a"] == pytest.approx(0.2, rel=1e-3)
     assert p["kd.b"] == pytest.approx(0.2, rel=1e-3)
     assert f.metrics["rel_mse"] < 1e-8
@@ -121,26 +125,38 @@ def test_refinement_lowers_its_objective(grid8):
 
 
 def test_unknown_and_mistyped_options_are_named(grid8):
-    with pytest.raises(ValueError, match=r"^search: unknown option 'restart' \(did you mean 'restarts'\?\) \(accepted: .*restarts"):
+    # The config reader's words: Python values are read as the TOML values they are.
+    with pytest.raises(ValueError, match=r"^search: restart: unknown key for kind = \"search\" \(accepted: .*restarts.*\) \(did you mean 'restarts'\?\)$"):
         bf.search(grid8, restart=2)
-    with pytest.raises(ValueError, match=r"^mccool: texture_size: expected an integer in 2..1024 or \"auto\", found 1$"):
+    with pytest.raises(ValueError, match=r"^mccool: texture_size: expected an integer in 2..1024 or \"auto\", found 1 \(an integer\)$"):
         bf.mccool(grid8, texture_size=1)
-    with pytest.raises(ValueError, match=r"^search: restarts: expected an integer in 0..100000, found '2' \(str\)$"):
+    with pytest.raises(ValueError, match=r"^search: restarts: expected an integer in 0..100000, found \"2\" \(a string\)$"):
         bf.search(grid8, restarts="2")
     with pytest.raises(ValueError, match=r"^search: terms: expected an integer in 1..64, found 4294967296$"):
         bf.search(grid8, terms=2**32)
-    with pytest.raises(ValueError, match=r"^svd: log: expected True or False, found 1 \(int\)$"):
+    with pytest.raises(ValueError, match=r"^svd: log: expected true or false, found 1 \(an integer\)$"):
         bf.svd(bf.brdf("lambert"), log=1)
+    with pytest.raises(ValueError, match=r"^mccool: metric_eps: expected a number in \(0, 1\], found 2$"):
+        bf.mccool(grid8, metric_eps=2.0)
+    with pytest.raises(ValueError, match=r"^search: label: names or sweeps a config's \[\[method\]\] table"):
+        bf.search(grid8, label="x")
+    with pytest.raises(ValueError, match=r"^mccool: refine: expected a value a config holds .*found <object"):
+        bf.mccool(grid8, refine=object())
+    # Every problem of a call is reported, each on its own line, as the CLI lists them.
+    with pytest.raises(ValueError) as e:
+        bf.mccool(grid8, smoothing=-1.0, solve_last=0)
+    assert str(e.value).splitlines() == ["mccool: smoothing: expected a number >= 0, found -1",
+                                         "mccool: solve_last: expected an integer in 1..64, found 0"]
     # Ranges as the config reader words them, and rules of the options' validate().
     with pytest.raises(ValueError, match=r"^mccool: smoothing: expected a number >= 0, found -1$"):
         bf.mccool(grid8, smoothing=-1.0)
     with pytest.raises(ValueError, match=r"^search: beam: expected 1..\(restarts \+ guesses\) = 1..2, found 9$"):
         bf.search(grid8, restarts=2, beam=9)
-    with pytest.raises(ValueError, match=r"^search: restarts: 0 restarts and no guesses"):
+    with pytest.raises(ValueError, match=r"^search: restarts: restarts = 0 and no guesses leave nothing to search from"):
         bf.search(grid8, restarts=0)
-    with pytest.raises(ValueError, match=r"^svd: eps: applies only to the log-space SVD"):
+    with pytest.raises(ValueError, match=r"^svd: eps: eps applies only to the log-space SVD"):
         bf.svd(bf.brdf("lambert"), eps=1e-3)
-    with pytest.raises(ValueError, match=r"^mccool: tolerance: metric: expected one of"):
+    with pytest.raises(ValueError, match=r"^mccool: tolerance.metric: expected one of"):
         bf.mccool(grid8, texture_size="auto", tolerance=("rel_mze", 0.1))
     with pytest.raises(ValueError, match=r"^model-fit: "):
         bf.model_fit(grid8, model="no-such-model")
