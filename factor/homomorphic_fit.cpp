@@ -149,15 +149,24 @@ void add_layout(const FitData& d, const TermSpec& s, int& M, std::vector<TermLay
     L.cell.resize(N);
     L.fa.resize(N);
     L.fb.resize(N);
+    const double m00 = fp.M(0, 0), m01 = fp.M(0, 1), m02 = fp.M(0, 2), m03 = fp.M(0, 3);
+    const double m10 = fp.M(1, 0), m11 = fp.M(1, 1), m12 = fp.M(1, 2), m13 = fp.M(1, 3);
+    const double off = fp.off, top = double(R - 1);
+    int* cell = L.cell.data();
+    double* fa = L.fa.data();
+    double* fb = L.fb.data();
+    uint8_t* mask = t.mask.data();
     for (size_t k = 0; k < N; ++k) {
-      const double u = std::clamp(fp.M.row(0).dot(x[k]) + fp.off, 0.0, double(R - 1));
-      const double v = std::clamp(fp.M.row(1).dot(x[k]) + fp.off, 0.0, double(R - 1));
+      const double* xk = x[k].data();
+      // Same sums in the same order as M.row(r).dot(x) + off.
+      const double u = std::clamp(m00 * xk[0] + m01 * xk[1] + m02 * xk[2] + m03 * xk[3] + off, 0.0, top);
+      const double v = std::clamp(m10 * xk[0] + m11 * xk[1] + m12 * xk[2] + m13 * xk[3] + off, 0.0, top);
       const int i = std::min(static_cast<int>(u), R - 2), j = std::min(static_cast<int>(v), R - 2);
       const int c = j * R + i;
-      L.cell[k] = c;
-      L.fa[k] = u - i;
-      L.fb[k] = v - j;
-      t.mask[c] = t.mask[c + 1] = t.mask[c + R] = t.mask[c + R + 1] = 1;
+      cell[k] = c;
+      fa[k] = u - i;
+      fb[k] = v - j;
+      mask[c] = mask[c + 1] = mask[c + R] = mask[c + R + 1] = 1;
     }
   }
   t.unk.assign(t.mask.size(), -1);
@@ -203,7 +212,8 @@ Workspace& workspace() {
 // earlier terms; blocks among terms before first_new are left as they are (a
 // JointPrefix filled them). A's lower triangle (and, for reciprocal new terms,
 // their whole diagonal block) and rhs must be zero where they are assembled.
-// r: the residual targets g - fixed per channel.
+// r: the residual targets g - fixed per channel. sum_wr2 (sum of w r^2 per
+// channel) is computed unless sum_wr2_known (a JointPrefix has it).
 //
 // Each lookup (a term's projection, or a reciprocal term's conjugate) is
 // handled in its own pass over the samples, in sample order, so every matrix
@@ -218,17 +228,28 @@ Workspace& workspace() {
 void assemble_dense(const FitData& d, const std::array<const double*, 3>& r,
                     const std::vector<TermLayout>& terms,
                     const std::vector<const std::array<Lookups, 2>*>& lookups, size_t first_new,
-                    Eigen::Ref<Eigen::MatrixXd> A, Eigen::Ref<Eigen::MatrixXd> rhs, double sum_wr2[3]) {
+                    Eigen::Ref<Eigen::MatrixXd> A, Eigen::Ref<Eigen::MatrixXd> rhs, double sum_wr2[3],
+                    bool sum_wr2_known = false) {
   const size_t N = d.size();
   const double* w = d.w.data();
   double* Ad = A.data();
   const size_t MM = static_cast<size_t>(A.outerStride());
   Workspace& ws = workspace();
 
-  for (int c = 0; c < 3; ++c) {
-    double s = 0;
-    for (size_t k = 0; k < N; ++k) s += w[k] * r[c][k] * r[c][k];
-    sum_wr2[c] = s;
+  if (!sum_wr2_known) {
+    // One loop, three independent chains (each channel summed in sample order).
+    double s0 = 0, s1 = 0, s2 = 0;
+    const double* r0 = r[0];
+    const double* r1 = r[1];
+    const double* r2 = r[2];
+    for (size_t k = 0; k < N; ++k) {
+      s0 += w[k] * r0[k] * r0[k];
+      s1 += w[k] * r1[k] * r1[k];
+      s2 += w[k] * r2[k] * r2[k];
+    }
+    sum_wr2[0] = s0;
+    sum_wr2[1] = s1;
+    sum_wr2[2] = s2;
   }
 
   // Flattened lookup list: (term, half) pairs in order, with each lookup's
@@ -369,6 +390,7 @@ struct JointPrefix::Impl {
   int M = 0;
   Eigen::MatrixXd A, rhs;  // data block of the known terms (lower triangle), M x M and M x 3
   std::array<std::vector<double>, 3> r;  // residual targets g - fixed_values, per channel
+  double sum_wr2[3] = {0, 0, 0};         // sum of w r^2 per channel
 };
 
 JointPrefix::JointPrefix(const FitData& d, const std::array<std::vector<double>, 3>& fixed_values,
@@ -387,8 +409,7 @@ JointPrefix::JointPrefix(const FitData& d, const std::array<std::vector<double>,
     p.r[c].resize(d.size());
     for (size_t k = 0; k < d.size(); ++k) p.r[c][k] = d.g[c][k] - fixed_values[c][k];
   }
-  double sum_wr2[3];
-  assemble_dense(d, {p.r[0].data(), p.r[1].data(), p.r[2].data()}, p.terms, lp, 0, p.A, p.rhs, sum_wr2);
+  assemble_dense(d, {p.r[0].data(), p.r[1].data(), p.r[2].data()}, p.terms, lp, 0, p.A, p.rhs, p.sum_wr2);
 }
 
 JointPrefix::~JointPrefix() = default;
@@ -541,7 +562,9 @@ JointSolution solve_joint(const FitData& d, const std::array<std::vector<double>
     }
     if (K > 0) rhs.topRows(pM) = prefix->impl().rhs;
     double sum_wr2[3];
-    assemble_dense(d, r, terms, lookups, K, A, rhs, sum_wr2);
+    if (K > 0)
+      for (int c = 0; c < 3; ++c) sum_wr2[c] = prefix->impl().sum_wr2[c];
+    assemble_dense(d, r, terms, lookups, K, A, rhs, sum_wr2, K > 0);
     double reg_diag = 0;  // Laplacian, gauge and ridge go into A; remember them for the objective
     for (const TermLayout& t : terms)
       laplacian_rows(t, [&](const int* li, const double* lv, int n) {
