@@ -482,7 +482,7 @@ JointSolution solve_joint(const FitData& d, const std::array<std::vector<double>
 
   FitOptions::Solver solver = opt.solver;
   if (solver == FitOptions::Solver::Auto)
-    solver = M <= 2500 ? FitOptions::Solver::Dense : FitOptions::Solver::Sparse;
+    solver = M <= 1800 ? FitOptions::Solver::Dense : FitOptions::Solver::Sparse;
 
   if (solver == FitOptions::Solver::Sparse) {
     using SpMat = Eigen::SparseMatrix<double>;
