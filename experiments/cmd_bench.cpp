@@ -12,6 +12,7 @@
 #include "brdfs/catalogue.h"
 #include "brdfs/sampleset.h"
 #include "experiments/commands.h"
+#include "factor/dense_kernels.h"
 #include "factor/homomorphic_fit.h"
 #include "search/rotation4.h"
 #include "search/planted.h"
@@ -141,6 +142,7 @@ void run_bench_fit(const BenchFitArgs& a) {
   j["repeats"] = a.repeats;
   j["rel_mse"] = sol.rel_mse;
   j["threads"] = 1;
+  j["kernel"] = kernels::active_variant();  // dense Cholesky variant (factor/dense_kernels.h)
   std::cout << j.dump() << std::endl;
 }
 struct BenchSearchArgs {
@@ -158,6 +160,7 @@ struct BenchSearchArgs {
   int threads = 0;
   double ftol = PowellOptions{}.ftol;
   double line_tol = PowellOptions{}.line_tol;
+  std::string line_search = to_string(PowellOptions{}.line_search);
   double smoothing = FitOptions{}.smoothing;
   std::vector<std::string> guesses;
   int beam = 1;
@@ -191,6 +194,7 @@ SearchOptions bench_search_options(const BenchSearchArgs& a, const std::string& 
   opt.threads = a.threads;
   opt.powell.ftol = a.ftol;
   opt.powell.line_tol = a.line_tol;
+  opt.powell.line_search = parse_line_search(a.line_search);
   opt.beam = a.beam;
   opt.backfit_sweeps = a.backfit_sweeps;
   opt.backfit_restarts = a.backfit_restarts;
@@ -215,6 +219,7 @@ nlohmann::json bench_one_search(const BenchSearchArgs& a, const FitData& d, cons
   j["terms"] = a.terms;
   j["restarts"] = a.restarts;
   j["optimizer"] = a.optimizer;
+  j["line_search"] = a.line_search;
   j["threads"] = hardware_threads(a.threads);
   j["beam"] = a.beam;
   j["backfit_sweeps"] = a.backfit_sweeps;
@@ -406,6 +411,7 @@ void add_cmd_bench(CLI::App& app) {
   search->add_option("--threads", b->threads, "threads for the restarts (0 = all cores)")->capture_default_str();
   search->add_option("--ftol", b->ftol, "relative improvement per sweep to go on")->capture_default_str();
   search->add_option("--line-tol", b->line_tol, "golden-section bracket width (t)")->capture_default_str();
+  search->add_option("--line-search", b->line_search, "line refinement: golden or brent")->capture_default_str();
   search->add_option("--smoothing", b->smoothing, "Laplacian weight")->capture_default_str();
   search->add_option("--beam", b->beam, "first-term candidates continued (1 = greedy)")->capture_default_str();
   search->add_option("--backfit-sweeps", b->backfit_sweeps, "cyclic re-search sweeps after each term")

@@ -1,5 +1,6 @@
 // Homomorphic least-squares fit (see homomorphic_fit.h for the formulation).
 #include "factor/homomorphic_fit.h"
+#include "factor/dense_kernels.h"
 #include "solvers/cancel.h"
 #include "solvers/option_error.h"
 
@@ -7,6 +8,9 @@
 #include <Eigen/QR>
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
+#ifdef BF_FACTOR_CHOLMOD
+#include <Eigen/CholmodSupport>
+#endif
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -149,15 +153,24 @@ void add_layout(const FitData& d, const TermSpec& s, int& M, std::vector<TermLay
     L.cell.resize(N);
     L.fa.resize(N);
     L.fb.resize(N);
+    const double m00 = fp.M(0, 0), m01 = fp.M(0, 1), m02 = fp.M(0, 2), m03 = fp.M(0, 3);
+    const double m10 = fp.M(1, 0), m11 = fp.M(1, 1), m12 = fp.M(1, 2), m13 = fp.M(1, 3);
+    const double off = fp.off, top = double(R - 1);
+    int* cell = L.cell.data();
+    double* fa = L.fa.data();
+    double* fb = L.fb.data();
+    uint8_t* mask = t.mask.data();
     for (size_t k = 0; k < N; ++k) {
-      const double u = std::clamp(fp.M.row(0).dot(x[k]) + fp.off, 0.0, double(R - 1));
-      const double v = std::clamp(fp.M.row(1).dot(x[k]) + fp.off, 0.0, double(R - 1));
+      const double* xk = x[k].data();
+      // Same sums in the same order as M.row(r).dot(x) + off.
+      const double u = std::clamp(m00 * xk[0] + m01 * xk[1] + m02 * xk[2] + m03 * xk[3] + off, 0.0, top);
+      const double v = std::clamp(m10 * xk[0] + m11 * xk[1] + m12 * xk[2] + m13 * xk[3] + off, 0.0, top);
       const int i = std::min(static_cast<int>(u), R - 2), j = std::min(static_cast<int>(v), R - 2);
       const int c = j * R + i;
-      L.cell[k] = c;
-      L.fa[k] = u - i;
-      L.fb[k] = v - j;
-      t.mask[c] = t.mask[c + 1] = t.mask[c + R] = t.mask[c + R + 1] = 1;
+      cell[k] = c;
+      fa[k] = u - i;
+      fb[k] = v - j;
+      mask[c] = mask[c + 1] = mask[c + R] = mask[c + R + 1] = 1;
     }
   }
   t.unk.assign(t.mask.size(), -1);
@@ -168,86 +181,149 @@ void add_layout(const FitData& d, const TermSpec& s, int& M, std::vector<TermLay
   terms.push_back(std::move(t));
 }
 
+// Per-cell sums of one lookup's self-products: the 10 entries of the 4x4
+// product of its bilinear weights and the 4x3 right-hand side sums.
+struct CellAcc {
+  double q[10];  // (0,0) (1,0) (2,0) (3,0) (1,1) (2,1) (3,1) (2,2) (3,2) (3,3)
+  double r[4][3];
+};
+
+// Scratch buffers of the dense path, one set per thread, reused across fits so
+// that the search's inner loop does not allocate (glibc returns the large
+// normal matrix to the OS with munmap at every free, and every fit then paid
+// its page faults again). Only buffers whose contents are rebuilt by every fit
+// live here; nothing is carried from one fit to the next.
+struct Workspace {
+  std::vector<double> A;                    // normal matrix, M x M column-major
+  std::vector<CellAcc> cells;               // per-cell sums, all new lookups
+  std::vector<int> corners;                 // per lookup and cell: its 4 unknowns
+  std::array<std::vector<double>, 3> r;     // residual targets g - fixed, per channel
+  std::vector<std::array<Lookups, 2>> own;  // lookups of the terms not in a prefix
+  // Buffers above this many doubles (32 MB) are released after the fit.
+  static constexpr size_t kKeep = size_t(4) << 20;
+  void trim() {
+    if (A.capacity() > kKeep) std::vector<double>().swap(A);
+  }
+};
+
+Workspace& workspace() {
+  thread_local Workspace ws;
+  return ws;
+}
+
 // The data part of the dense normal equations (lower triangle of A, rhs and
 // sum w r^2 per channel) for terms first_new.. and their products with the
 // earlier terms; blocks among terms before first_new are left as they are (a
-// JointPrefix filled them). Fast assembly: a lookup's 4x4 self-product only
-// touches the texels of its bilinear cell, so it is accumulated (10 sums, plus
-// 4x3 right-hand side sums) per (term, cell) in small arrays that stay in
-// cache and scattered once; products of two different lookups (different
-// terms, or a reciprocal term's projection and conjugate) go straight into the
-// lower triangle of A (column-major, 4 columns x 4 rows each).
-void assemble_dense(const FitData& d, const std::array<std::vector<double>, 3>& fixed_values,
+// JointPrefix filled them). A's lower triangle (and, for reciprocal new terms,
+// their whole diagonal block) and rhs must be zero where they are assembled.
+// r: the residual targets g - fixed per channel. sum_wr2 (sum of w r^2 per
+// channel) is computed unless sum_wr2_known (a JointPrefix has it).
+//
+// Each lookup (a term's projection, or a reciprocal term's conjugate) is
+// handled in its own pass over the samples, in sample order, so every matrix
+// entry receives its sums in the same order as a per-sample loop would, for
+// non-reciprocal terms bit for bit:
+//  - a lookup's 4x4 self-product only touches the texels of its bilinear cell,
+//    so it is accumulated (10 sums, plus 4x3 right-hand side sums) per cell in
+//    a small array that stays in cache and is scattered once;
+//  - products of two different lookups (different terms, or a reciprocal
+//    term's projection and conjugate) go straight into A (column-major, 4
+//    columns x 4 rows each), through a per-cell table of the 4 unknowns.
+void assemble_dense(const FitData& d, const std::array<const double*, 3>& r,
                     const std::vector<TermLayout>& terms,
                     const std::vector<const std::array<Lookups, 2>*>& lookups, size_t first_new,
-                    Eigen::MatrixXd& A, Eigen::MatrixXd& rhs, double sum_wr2[3]) {
+                    Eigen::Ref<Eigen::MatrixXd> A, Eigen::Ref<Eigen::MatrixXd> rhs, double sum_wr2[3],
+                    bool sum_wr2_known = false) {
   const size_t N = d.size();
+  const double* w = d.w.data();
   double* Ad = A.data();
-  const size_t MM = static_cast<size_t>(A.rows());
-  struct CellAcc {
-    double q[10];  // (0,0) (1,0) (2,0) (3,0) (1,1) (2,1) (3,1) (2,2) (3,2) (3,3)
-    double r[4][3];
+  const size_t MM = static_cast<size_t>(A.outerStride());
+  Workspace& ws = workspace();
+
+  if (!sum_wr2_known) {
+    // One loop, three independent chains (each channel summed in sample order).
+    double s0 = 0, s1 = 0, s2 = 0;
+    const double* r0 = r[0];
+    const double* r1 = r[1];
+    const double* r2 = r[2];
+    for (size_t k = 0; k < N; ++k) {
+      s0 += w[k] * r0[k] * r0[k];
+      s1 += w[k] * r1[k] * r1[k];
+      s2 += w[k] * r2[k] * r2[k];
+    }
+    sum_wr2[0] = s0;
+    sum_wr2[1] = s1;
+    sum_wr2[2] = s2;
+  }
+
+  // Flattened lookup list: (term, half) pairs in order, with each lookup's
+  // cell -> 4 unknowns table.
+  struct Sub {
+    int term, half;
+    const Lookups* lk;
+    size_t corners;  // offset into ws.corners
   };
-  std::vector<std::vector<CellAcc>> cells(terms.size());
-  for (size_t ti = first_new; ti < terms.size(); ++ti)
-    cells[ti].assign(size_t(terms[ti].proj.res) * terms[ti].proj.res, CellAcc{});
-  // Flattened lookup list: (term, half) pairs in order.
-  std::vector<std::pair<int, int>> subs;
+  std::vector<Sub> subs;
   int first_new_sub = -1;
+  size_t ncorner = 0;
   for (size_t ti = 0; ti < terms.size(); ++ti)
     for (int h = 0; h < (terms[ti].reciprocal ? 2 : 1); ++h) {
       if (ti >= first_new && first_new_sub < 0) first_new_sub = static_cast<int>(subs.size());
-      subs.emplace_back(int(ti), h);
+      subs.push_back({int(ti), h, &(*lookups[ti])[h], ncorner});
+      if (h == 0) ncorner += 4 * size_t(terms[ti].proj.res) * terms[ti].proj.res;
     }
   const int S = static_cast<int>(subs.size());
   if (first_new_sub < 0) first_new_sub = S;
-  std::vector<int> sidx(4 * S);
-  std::vector<double> sw(4 * S);
-  for (int c = 0; c < 3; ++c) sum_wr2[c] = 0;
-  for (size_t k = 0; k < N; ++k) {
-    const double w = d.w[k];
-    const double r[3] = {d.g[0][k] - fixed_values[0][k], d.g[1][k] - fixed_values[1][k],
-                         d.g[2][k] - fixed_values[2][k]};
-    for (int c = 0; c < 3; ++c) sum_wr2[c] += w * r[c] * r[c];
-    for (int p = 0; p < S; ++p) {
-      const int ti = subs[p].first;
-      const Lookups& lk = (*lookups[ti])[subs[p].second];
-      const int cell = lk.cell[k];
-      const double fa = lk.fa[k], fb = lk.fb[k];
-      const double b0 = (1 - fa) * (1 - fb), b1 = fa * (1 - fb), b2 = (1 - fa) * fb, b3 = fa * fb;
-      if (p >= first_new_sub) {
-        CellAcc& acc = cells[ti][cell];
-        const double wb0 = w * b0, wb1 = w * b1, wb2 = w * b2, wb3 = w * b3;
-        acc.q[0] += wb0 * b0; acc.q[1] += wb1 * b0; acc.q[2] += wb2 * b0; acc.q[3] += wb3 * b0;
-        acc.q[4] += wb1 * b1; acc.q[5] += wb2 * b1; acc.q[6] += wb3 * b1;
-        acc.q[7] += wb2 * b2; acc.q[8] += wb3 * b2; acc.q[9] += wb3 * b3;
-        for (int c = 0; c < 3; ++c) {
-          acc.r[0][c] += wb0 * r[c]; acc.r[1][c] += wb1 * r[c];
-          acc.r[2][c] += wb2 * r[c]; acc.r[3][c] += wb3 * r[c];
-        }
+  if (S > 1) {
+    ws.corners.resize(ncorner);
+    for (Sub& s : subs) {
+      if (s.half == 1) {
+        s.corners = subs[&s - subs.data() - 1].corners;  // same term, same table
+        continue;
       }
-      if (S > 1) {
-        const int R = terms[ti].proj.res;
-        const std::vector<int>& unk = terms[ti].unk;
-        sidx[4 * p] = unk[cell]; sidx[4 * p + 1] = unk[cell + 1];
-        sidx[4 * p + 2] = unk[cell + R]; sidx[4 * p + 3] = unk[cell + R + 1];
-        sw[4 * p] = b0; sw[4 * p + 1] = b1; sw[4 * p + 2] = b2; sw[4 * p + 3] = b3;
+      const TermLayout& t = terms[s.term];
+      const int R = t.proj.res;
+      int* cn = ws.corners.data() + s.corners;
+      for (int j = 0; j + 1 < R; ++j)
+        for (int i = 0; i + 1 < R; ++i) {
+          const int cell = j * R + i;
+          cn[4 * cell] = t.unk[cell];
+          cn[4 * cell + 1] = t.unk[cell + 1];
+          cn[4 * cell + 2] = t.unk[cell + R];
+          cn[4 * cell + 3] = t.unk[cell + R + 1];
+        }
+    }
+  }
+
+  // Cross products of different lookups, pair by pair: q later than p, so for
+  // different terms idx_q > idx_p (lower triangle); same-term (reciprocal)
+  // pairs are folded below. Pairs with both lookups before first_new are the
+  // prefix's.
+  for (int p = 0; p < S; ++p)
+    for (int q = std::max(p + 1, first_new_sub); q < S; ++q) {
+      const Lookups& lp = *subs[p].lk;
+      const Lookups& lq = *subs[q].lk;
+      const int* cnp = ws.corners.data() + subs[p].corners;
+      const int* cnq = ws.corners.data() + subs[q].corners;
+      for (size_t k = 0; k < N; ++k) {
+        const double a = lp.fa[k], b = lp.fb[k];
+        const double wk = w[k];
+        const double sp[4] = {wk * ((1 - a) * (1 - b)), wk * (a * (1 - b)), wk * ((1 - a) * b), wk * (a * b)};
+        const double c2 = lq.fa[k], d2 = lq.fb[k];
+        const double sq[4] = {(1 - c2) * (1 - d2), c2 * (1 - d2), (1 - c2) * d2, c2 * d2};
+        const int* ip = cnp + 4 * lp.cell[k];
+        const int* iq = cnq + 4 * lq.cell[k];
+        const int q0 = iq[0], q1 = iq[1], q2 = iq[2], q3 = iq[3];
+        for (int a2 = 0; a2 < 4; ++a2) {
+          double* col = Ad + static_cast<size_t>(ip[a2]) * MM;
+          const double wa = sp[a2];
+          col[q0] += wa * sq[0];
+          col[q1] += wa * sq[1];
+          col[q2] += wa * sq[2];
+          col[q3] += wa * sq[3];
+        }
       }
     }
-    // Cross products of different lookups: q later than p, so for different
-    // terms idx_q > idx_p (lower triangle). Same-term pairs are folded below.
-    // Pairs with both lookups before first_new are the prefix's.
-    for (int p = 0; p < S; ++p)
-      for (int q = std::max(p + 1, first_new_sub); q < S; ++q)
-        for (int a2 = 0; a2 < 4; ++a2) {
-          double* col = Ad + static_cast<size_t>(sidx[4 * p + a2]) * MM;
-          const double wa = w * sw[4 * p + a2];
-          col[sidx[4 * q]] += wa * sw[4 * q];
-          col[sidx[4 * q + 1]] += wa * sw[4 * q + 1];
-          col[sidx[4 * q + 2]] += wa * sw[4 * q + 2];
-          col[sidx[4 * q + 3]] += wa * sw[4 * q + 3];
-        }
-  }
   // Fold reciprocal terms' upper-triangle entries into the lower triangle.
   // Each cross product s_p s_q^T was added once; the symmetric pair
   // s_p s_q^T + s_q s_p^T needs its diagonal twice. (So far only these
@@ -263,14 +339,39 @@ void assemble_dense(const FitData& d, const std::array<std::vector<double>, 3>& 
       }
     }
   }
-  // Scatter the per-cell sums into the lower triangle and the right-hand side.
-  for (size_t ti = first_new; ti < terms.size(); ++ti) {
-    const TermLayout& t = terms[ti];
+
+  // Self-products of the new lookups, per cell.
+  for (int p = first_new_sub; p < S; ++p) {
+    const TermLayout& t = terms[subs[p].term];
     const int R = t.proj.res;
-    for (size_t cell = 0; cell < cells[ti].size(); ++cell) {
-      const CellAcc& acc = cells[ti][cell];
+    ws.cells.assign(size_t(R) * R, CellAcc{});
+    CellAcc* cells = ws.cells.data();
+    const Lookups& lk = *subs[p].lk;
+    const int* cell = lk.cell.data();
+    const double* fa = lk.fa.data();
+    const double* fb = lk.fb.data();
+    const double* r0 = r[0];
+    const double* r1 = r[1];
+    const double* r2 = r[2];
+    for (size_t k = 0; k < N; ++k) {
+      const double a = fa[k], b = fb[k], wk = w[k];
+      const double b0 = (1 - a) * (1 - b), b1 = a * (1 - b), b2 = (1 - a) * b, b3 = a * b;
+      CellAcc& acc = cells[cell[k]];
+      const double wb0 = wk * b0, wb1 = wk * b1, wb2 = wk * b2, wb3 = wk * b3;
+      acc.q[0] += wb0 * b0; acc.q[1] += wb1 * b0; acc.q[2] += wb2 * b0; acc.q[3] += wb3 * b0;
+      acc.q[4] += wb1 * b1; acc.q[5] += wb2 * b1; acc.q[6] += wb3 * b1;
+      acc.q[7] += wb2 * b2; acc.q[8] += wb3 * b2; acc.q[9] += wb3 * b3;
+      const double rk[3] = {r0[k], r1[k], r2[k]};
+      for (int c = 0; c < 3; ++c) {
+        acc.r[0][c] += wb0 * rk[c]; acc.r[1][c] += wb1 * rk[c];
+        acc.r[2][c] += wb2 * rk[c]; acc.r[3][c] += wb3 * rk[c];
+      }
+    }
+    // Scatter the per-cell sums into the lower triangle and the right-hand side.
+    for (size_t c0 = 0; c0 < ws.cells.size(); ++c0) {
+      const CellAcc& acc = cells[c0];
       if (acc.q[0] == 0 && acc.q[4] == 0 && acc.q[7] == 0 && acc.q[9] == 0) continue;
-      const int id[4] = {t.unk[cell], t.unk[cell + 1], t.unk[cell + R], t.unk[cell + R + 1]};
+      const int id[4] = {t.unk[c0], t.unk[c0 + 1], t.unk[c0 + R], t.unk[c0 + R + 1]};
       const int pairs[10][2] = {{0, 0}, {1, 0}, {2, 0}, {3, 0}, {1, 1},
                                 {2, 1}, {3, 1}, {2, 2}, {3, 2}, {3, 3}};
       for (int e = 0; e < 10; ++e) {
@@ -281,6 +382,7 @@ void assemble_dense(const FitData& d, const std::array<std::vector<double>, 3>& 
         for (int c = 0; c < 3; ++c) rhs(id[v], c) += acc.r[v][c];
     }
   }
+
 }
 
 }  // namespace
@@ -291,6 +393,8 @@ struct JointPrefix::Impl {
   std::vector<std::array<Lookups, 2>> lookups;
   int M = 0;
   Eigen::MatrixXd A, rhs;  // data block of the known terms (lower triangle), M x M and M x 3
+  std::array<std::vector<double>, 3> r;  // residual targets g - fixed_values, per channel
+  double sum_wr2[3] = {0, 0, 0};         // sum of w r^2 per channel
 };
 
 JointPrefix::JointPrefix(const FitData& d, const std::array<std::vector<double>, 3>& fixed_values,
@@ -305,8 +409,11 @@ JointPrefix::JointPrefix(const FitData& d, const std::array<std::vector<double>,
   p.rhs = Eigen::MatrixXd::Zero(p.M, 3);
   std::vector<const std::array<Lookups, 2>*> lp;
   for (const auto& l : p.lookups) lp.push_back(&l);
-  double sum_wr2[3];
-  assemble_dense(d, fixed_values, p.terms, lp, 0, p.A, p.rhs, sum_wr2);
+  for (int c = 0; c < 3; ++c) {
+    p.r[c].resize(d.size());
+    for (size_t k = 0; k < d.size(); ++k) p.r[c][k] = d.g[c][k] - fixed_values[c][k];
+  }
+  assemble_dense(d, {p.r[0].data(), p.r[1].data(), p.r[2].data()}, p.terms, lp, 0, p.A, p.rhs, p.sum_wr2);
 }
 
 JointPrefix::~JointPrefix() = default;
@@ -323,7 +430,9 @@ JointSolution solve_joint(const FitData& d, const std::array<std::vector<double>
   // Layout: the prefix's terms (if any), then the others.
   size_t K = 0;  // terms taken from the prefix
   std::vector<TermLayout> terms;
-  std::vector<std::array<Lookups, 2>> own(joint.size());
+  // The new terms' lookups: the thread's workspace (capacity kept across fits).
+  std::vector<std::array<Lookups, 2>>& own = workspace().own;
+  own.resize(joint.size());
   std::vector<const std::array<Lookups, 2>*> lookups;
   terms.reserve(joint.size());
   int M = 0;
@@ -378,7 +487,7 @@ JointSolution solve_joint(const FitData& d, const std::array<std::vector<double>
 
   FitOptions::Solver solver = opt.solver;
   if (solver == FitOptions::Solver::Auto)
-    solver = M <= 2500 ? FitOptions::Solver::Dense : FitOptions::Solver::Sparse;
+    solver = M <= 1500 ? FitOptions::Solver::Dense : FitOptions::Solver::Sparse;
 
   if (solver == FitOptions::Solver::Sparse) {
     using SpMat = Eigen::SparseMatrix<double>;
@@ -420,21 +529,53 @@ JointSolution solve_joint(const FitData& d, const std::array<std::vector<double>
       A.coeffRef(i0, i0) += mean_diag;
     }
     for (int i = 0; i < M; ++i) A.coeffRef(i, i) += 1e-12 * mean_diag + std::numeric_limits<double>::min();
+#ifdef BF_FACTOR_CHOLMOD
+    // SuiteSparse's supernodal Cholesky (dense BLAS blocks on the supernodes):
+    // several times faster than the simplicial LLT at texture 64 (docs/speed.md).
+    Eigen::CholmodSupernodalLLT<SpMat, Eigen::Lower> llt(A);
+#else
     Eigen::SimplicialLLT<SpMat, Eigen::Lower, Eigen::AMDOrdering<int>> llt(A);
+#endif
     if (llt.info() != Eigen::Success)
       throw std::runtime_error("fit: the normal matrix is not positive definite (" +
                                std::to_string(M) + " unknowns)");
     Y = llt.solve(rhs);
   } else if (solver == FitOptions::Solver::Dense) {
-    Eigen::MatrixXd A = Eigen::MatrixXd::Zero(M, M);
+    // The normal matrix lives in the thread's workspace (no allocation once it
+    // has grown); only its lower triangle is cleared, filled and factored.
+    Workspace& ws = workspace();
+    ws.A.resize(size_t(M) * M);
+    Eigen::Map<Eigen::MatrixXd> A(ws.A.data(), M, M);
     Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(M, 3);
-    if (K > 0) {  // the prefix's data block
-      const JointPrefix::Impl& p = prefix->impl();
-      A.topLeftCorner(p.M, p.M) = p.A;
-      rhs.topRows(p.M) = p.rhs;
+    const int pM = K > 0 ? prefix->impl().M : 0;
+    for (int j = 0; j < M; ++j) {
+      if (j < pM) {  // the prefix's data block
+        A.col(j).segment(j, pM - j) = prefix->impl().A.col(j).segment(j, pM - j);
+        A.col(j).tail(M - pM).setZero();
+      } else {
+        A.col(j).tail(M - j).setZero();
+      }
     }
+    for (size_t ti = K; ti < terms.size(); ++ti)  // assembly writes their upper triangle too
+      if (terms[ti].reciprocal)
+        A.block(terms[ti].first, terms[ti].first, terms[ti].count, terms[ti].count)
+            .triangularView<Eigen::StrictlyUpper>()
+            .setZero();
+    std::array<const double*, 3> r;
+    if (K > 0) {
+      for (int c = 0; c < 3; ++c) r[c] = prefix->impl().r[c].data();
+    } else {
+      for (int c = 0; c < 3; ++c) {
+        ws.r[c].resize(N);
+        for (size_t k = 0; k < N; ++k) ws.r[c][k] = d.g[c][k] - fixed_values[c][k];
+        r[c] = ws.r[c].data();
+      }
+    }
+    if (K > 0) rhs.topRows(pM) = prefix->impl().rhs;
     double sum_wr2[3];
-    assemble_dense(d, fixed_values, terms, lookups, K, A, rhs, sum_wr2);
+    if (K > 0)
+      for (int c = 0; c < 3; ++c) sum_wr2[c] = prefix->impl().sum_wr2[c];
+    assemble_dense(d, r, terms, lookups, K, A, rhs, sum_wr2, K > 0);
     double reg_diag = 0;  // Laplacian, gauge and ridge go into A; remember them for the objective
     for (const TermLayout& t : terms)
       laplacian_rows(t, [&](const int* li, const double* lv, int n) {
@@ -450,11 +591,14 @@ JointSolution solve_joint(const FitData& d, const std::array<std::vector<double>
     }
     reg_diag = 1e-12 * mean_diag + std::numeric_limits<double>::min();
     A.diagonal().array() += reg_diag;
-    Eigen::LLT<Eigen::Ref<Eigen::MatrixXd>, Eigen::Lower> llt(A);  // in place
-    if (llt.info() != Eigen::Success)
+    // In place, one factorization for the 3 channels; the CPU's widest
+    // instruction set (factor/dense_kernels.h).
+    Y = rhs;
+    const bool pd = kernels::llt_solve(A.data(), M, Y.data(), 3);
+    ws.trim();
+    if (!pd)
       throw std::runtime_error("fit: the normal matrix is not positive definite (" +
                                std::to_string(M) + " unknowns)");
-    Y = llt.solve(rhs);
     if (!exact_error) {
       // At the solution A y = rhs, so the data residual is
       // sum w r^2 - y.rhs - (regularization quadratic form at y).
@@ -585,11 +729,8 @@ Eigen::MatrixXd joint_normal_matrix(const FitData& d, const std::vector<TermSpec
   if (unknowns) *unknowns = static_cast<size_t>(M);
   if (static_cast<size_t>(M) > max_unknowns) return Eigen::MatrixXd();
   Eigen::MatrixXd A = Eigen::MatrixXd::Zero(M, M), rhs = Eigen::MatrixXd::Zero(M, 3);
-  const std::array<std::vector<double>, 3> no_fixed{std::vector<double>(d.size(), 0.0),
-                                                    std::vector<double>(d.size(), 0.0),
-                                                    std::vector<double>(d.size(), 0.0)};
   double sum_wr2[3];
-  assemble_dense(d, no_fixed, terms, lookups, 0, A, rhs, sum_wr2);
+  assemble_dense(d, {d.g[0].data(), d.g[1].data(), d.g[2].data()}, terms, lookups, 0, A, rhs, sum_wr2);
   const double mu = opt.smoothing * d.W / std::max(M, 1);
   for (const TermLayout& t : terms)
     laplacian_rows(t, [&](const int* li, const double* lv, int n) {

@@ -44,8 +44,8 @@ struct FitOptions {
   bool subtract_eps = true;  // reconstruct A exp(s) - eps A (clamped at 0) instead of A exp(s)
   int solve_last = 2;        // n: the last n terms are solved jointly, >= 1
   // Dense: normal matrix assembled densely, LLT. Sparse: B assembled sparse,
-  // B^T W B by sparse product, SimplicialLLT (AMD ordering). Auto: dense up to
-  // 2500 unknowns, sparse above (measured crossover, docs/results.md §2). ReferenceQR: the
+  // B^T W B by sparse product, CHOLMOD supernodal LLT (SimplicialLLT without CHOLMOD). Auto: dense up to
+  // 1500 unknowns, sparse above (measured crossover, docs/speed.md "Inner loop"). ReferenceQR: the
   // simple path (dense B, Householder QR, no normal equations) for tests.
   enum class Solver { Auto, Dense, Sparse, ReferenceQR } solver = Solver::Auto;
   // Throws std::invalid_argument naming the field, its value and the rule.

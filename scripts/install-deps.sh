@@ -13,6 +13,7 @@ PACKAGES=(
   build-essential cmake ninja-build pkg-config
   libeigen3-dev          # linear algebra (3.4)
   libceres-dev           # nonlinear least squares (2.1)
+  libsuitesparse-dev     # CHOLMOD, the sparse fit's supernodal Cholesky (also a libceres-dev dependency)
   libopenexr-dev         # EXR textures and environment maps (3.1)
   libpng-dev             # PNG previews and renders (1.6)
   libnlopt-cxx-dev       # alternative optimizers (2.7)

@@ -2,6 +2,7 @@
 #include "search/powell.h"
 #include "solvers/option_error.h"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -23,6 +24,83 @@ void PowellOptions::validate() const {
                                 std::to_string(max_evaluations));
 }
 
+PowellOptions::LineSearch parse_line_search(const std::string& name) {
+  if (name == "golden") return PowellOptions::LineSearch::Golden;
+  if (name == "brent") return PowellOptions::LineSearch::Brent;
+  throw OptionError("line_search", "line_search: expected \"golden\" or \"brent\", found \"" + name + "\"");
+}
+
+std::string to_string(PowellOptions::LineSearch ls) {
+  return ls == PowellOptions::LineSearch::Brent ? "brent" : "golden";
+}
+
+namespace {
+
+// Brent's method on the bracket [lo, hi] around x (fx <= the values at lo and
+// hi, which are flo and fhi): parabolic steps through the three best points
+// so far, a golden-section step whenever the parabola's step is outside the
+// bracket or does not shrink fast enough (more than half the step before
+// last). Stops when x is within the tolerance of the bracket's middle, i.e.
+// the bracket is about line_tol wide, as for the golden section. The first
+// parabola goes through the bracket itself, so it costs no extra evaluation.
+template <class G>
+double brent_refine(G& g, double lo, double flo, double x, double fx, double hi, double fhi,
+                    double line_tol, double* best_t) {
+  constexpr double kCGold = 0.3819660112501051;  // 1 - 1/golden ratio
+  const double tol = 0.25 * line_tol;
+  double a = lo, b = hi;
+  // w: second best point, v: third best (the previous w).
+  double w = flo <= fhi ? lo : hi, fw = std::min(flo, fhi);
+  double v = flo <= fhi ? hi : lo, fv = std::max(flo, fhi);
+  double d = 0.0, e = b - a;  // this step and the one before last
+  for (int it = 0; it < 200; ++it) {
+    const double xm = 0.5 * (a + b);
+    if (std::abs(x - xm) <= 2 * tol - 0.5 * (b - a)) break;
+    bool golden = true;
+    if (std::abs(e) > tol) {
+      // Vertex of the parabola through (x, fx), (w, fw), (v, fv) as x + p / q.
+      const double r = (x - w) * (fx - fv);
+      double q = (x - v) * (fx - fw);
+      double p = (x - v) * q - (x - w) * r;
+      q = 2.0 * (q - r);
+      if (q > 0) p = -p;
+      q = std::abs(q);
+      const double e_before = e;
+      e = d;
+      if (std::abs(p) < std::abs(0.5 * q * e_before) && p > q * (a - x) && p < q * (b - x)) {
+        d = p / q;
+        const double u = x + d;
+        if (u - a < 2 * tol || b - u < 2 * tol) d = std::copysign(tol, xm - x);
+        golden = false;
+      }
+    }
+    if (golden) {
+      e = x >= xm ? a - x : b - x;
+      d = kCGold * e;
+    }
+    const double u = std::abs(d) >= tol ? x + d : x + std::copysign(tol, d);
+    const double fu = g(u);
+    if (fu <= fx) {
+      (u >= x ? a : b) = x;
+      v = w; fv = fw;
+      w = x; fw = fx;
+      x = u; fx = fu;
+    } else {
+      (u < x ? a : b) = u;
+      if (fu <= fw || w == x) {
+        v = w; fv = fw;
+        w = u; fw = fu;
+      } else if (fu <= fv || v == x || v == w) {
+        v = u; fv = fu;
+      }
+    }
+  }
+  *best_t = x;
+  return fx;
+}
+
+}  // namespace
+
 double line_minimize(const RotationObjective& f, const Rotation4& start, double f0,
                      const LineDirection& dir, const PowellOptions& opt, double* best_t,
                      int* evals) {
@@ -43,6 +121,8 @@ double line_minimize(const RotationObjective& f, const Rotation4& start, double 
     const double bm = -opt.initial_step, fbm = g(bm);
     if (fbm >= fa) {
       // (bm, 0, b) already brackets a minimum at the start.
+      if (opt.line_search == PowellOptions::LineSearch::Brent)
+        return brent_refine(g, bm, fbm, 0.0, f0, b, fb, opt.line_tol, best_t);
       double lo = bm, hi = b, x1, x2, f1, f2;
       x1 = hi - kR * (hi - lo);
       x2 = lo + kR * (hi - lo);
@@ -78,6 +158,18 @@ double line_minimize(const RotationObjective& f, const Rotation4& start, double 
   if (fc < fb) {  // no rise before the bound: the bound is the best we have
     *best_t = c;
     return fc;
+  }
+  if (opt.line_search == PowellOptions::LineSearch::Brent) {
+    double bt;
+    const double bv = a < c ? brent_refine(g, a, fa, b, fb, c, fc, opt.line_tol, &bt)
+                            : brent_refine(g, c, fc, b, fb, a, fa, opt.line_tol, &bt);
+    // Never worse than the start (a = 0 unless the bracket moved on).
+    if (f0 <= bv) {
+      *best_t = 0.0;
+      return f0;
+    }
+    *best_t = bt;
+    return bv;
   }
   // Golden-section search inside [min(a,c), max(a,c)] around b.
   double lo = std::min(a, c), hi = std::max(a, c);

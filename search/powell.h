@@ -1,10 +1,11 @@
 // Powell's direction-set minimization over 4D rotations (thesis 3.1.1-3.1.2):
-// lines R(t) = D^t R_s, golden-section line minimization with bracketing over
-// the periodic t, Cole's six initial directions, and the Numerical Recipes rule
+// lines R(t) = D^t R_s, golden-section (or Brent) line minimization with
+// bracketing over the periodic t, Cole's six initial directions, and the Numerical Recipes rule
 // for replacing a direction by the sweep's net direction.
 #pragma once
 
 #include <functional>
+#include <string>
 
 #include "search/rotation4.h"
 
@@ -17,11 +18,20 @@ struct PowellOptions {
   // 2 (f0 - fN) <= ftol (|f0| + |fN|) + 1e-20.
   double ftol = 1e-3;
   double line_tol = 0.02;     // golden section stops when the bracket is narrower (t, radians)
+  // Refinement of a bracketed line minimum: Golden (golden section, the
+  // original) or Brent (Brent's parabolic interpolation with golden-section
+  // safeguard, same final bracket width line_tol, fewer evaluations).
+  enum class LineSearch { Golden, Brent } line_search = LineSearch::Golden;
   double initial_step = 0.3;  // first bracketing step along t
   int max_sweeps = 30;        // >= 1
   int max_evaluations = 5000; // objective evaluations per minimization, >= 10
   void validate() const;      // throws std::invalid_argument naming the field
 };
+
+// "golden" / "brent" <-> LineSearch; parse throws std::invalid_argument naming
+// the field, the expected names and what was found.
+PowellOptions::LineSearch parse_line_search(const std::string& name);
+std::string to_string(PowellOptions::LineSearch ls);
 
 struct PowellResult {
   Rotation4 best;

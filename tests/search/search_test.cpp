@@ -63,6 +63,71 @@ TEST_CASE("powell: finds the minimum of a smooth function of the rotation") {
   CHECK(res.value <= f(Rotation4::identity()));
 }
 
+TEST_CASE("powell: Brent's line search finds the line minimum with fewer evaluations than the golden section") {
+  std::mt19937_64 rng(5);
+  const Rotation4 target = Rotation4::random(rng), start = Rotation4::random(rng);
+  // A smooth function of the rotation with its minimum away from the start;
+  // along each of Cole's directions it is a smooth periodic function of t.
+  const auto f = [&](const Rotation4& r) {
+    const Eigen::Matrix4d A = r.matrix(), B = target.matrix();
+    return (A.leftCols<2>() - B.leftCols<2>()).squaredNorm();
+  };
+  const double f0 = f(start);
+  int golden_total = 0, brent_total = 0;
+  for (const Rotation4& D : cole_basis_directions()) {
+    const LineDirection dir = LineDirection::from(D);
+    PowellOptions opt;
+    // Reference: the golden section to 1e-9.
+    opt.line_tol = 1e-9;
+    double t_ref;
+    int e_ref = 0;
+    const double v_ref = line_minimize(f, start, f0, dir, opt, &t_ref, &e_ref);
+    opt.line_tol = 0.02;
+    double t_gold, t_brent;
+    int e_gold = 0, e_brent = 0;
+    const double v_gold = line_minimize(f, start, f0, dir, opt, &t_gold, &e_gold);
+    opt.line_search = PowellOptions::LineSearch::Brent;
+    const double v_brent = line_minimize(f, start, f0, dir, opt, &t_brent, &e_brent);
+    INFO("t_ref " << t_ref << " golden " << t_gold << " (" << e_gold << " evaluations) brent " << t_brent << " ("
+                  << e_brent << ")");
+    CHECK(v_brent <= f0);
+    CHECK(v_brent >= v_ref - 1e-12);
+    // Both find the same local minimum to the tolerance (the line's minimum is smooth).
+    CHECK(std::abs(t_brent - t_ref) <= 0.02);
+    CHECK(std::abs(t_gold - t_ref) <= 0.02);
+    CHECK(v_brent <= v_gold + 1e-4 * std::abs(v_gold));
+    golden_total += e_gold;
+    brent_total += e_brent;
+  }
+  INFO("evaluations over the 6 lines: golden " << golden_total << ", brent " << brent_total);
+  CHECK(brent_total < golden_total);
+}
+
+TEST_CASE("powell: with Brent's line search finds the minimum of a smooth function of the rotation") {
+  std::mt19937_64 rng(9);
+  const Rotation4 target = Rotation4::random(rng);
+  const auto f = [&](const Rotation4& r) {
+    const Eigen::Matrix4d A = r.matrix(), B = target.matrix();
+    return (A.leftCols<2>() - B.leftCols<2>()).squaredNorm();
+  };
+  PowellOptions opt;
+  opt.ftol = 1e-10;
+  opt.line_tol = 1e-6;
+  opt.line_search = PowellOptions::LineSearch::Brent;
+  const PowellResult res = powell_minimize(f, Rotation4::identity(), opt);
+  INFO("value " << res.value << " after " << res.evaluations << " evaluations");
+  CHECK(res.value < 1e-6);
+}
+
+TEST_CASE("powell: an unknown line search name is refused with the known ones named") {
+  CHECK(parse_line_search("brent") == PowellOptions::LineSearch::Brent);
+  CHECK(parse_line_search("golden") == PowellOptions::LineSearch::Golden);
+  CHECK(to_string(parse_line_search("brent")) == "brent");
+  CHECK_THROWS_WITH(parse_line_search("parabolic"),
+                    Catch::Contains("line_search") && Catch::Contains("\"golden\" or \"brent\"") &&
+                        Catch::Contains("found \"parabolic\""));
+}
+
 TEST_CASE("search: recovers a planted single-term projection") {
   std::mt19937_64 rng(21);
   const Rotation4 truth = Rotation4::random(rng);

@@ -1,0 +1,62 @@
+// Tests of the runtime-dispatched dense kernels (factor/dense_kernels.h).
+#include <catch2/catch.hpp>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Core>
+#include <random>
+
+#include "factor/dense_kernels.h"
+
+using namespace bf;
+
+namespace {
+// A random symmetric positive definite n x n matrix (G G^T + n I).
+Eigen::MatrixXd random_spd(int n, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> nd;
+  Eigen::MatrixXd G(n, n);
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) G(i, j) = nd(rng);
+  return G * G.transpose() + n * Eigen::MatrixXd::Identity(n, n);
+}
+}  // namespace
+
+TEST_CASE("dense kernels: every supported variant solves an SPD system like Eigen's LLT") {
+  const std::vector<std::string> variants = kernels::supported_variants();
+  REQUIRE(!variants.empty());
+  CHECK(variants.front() == "generic");
+  bool active_listed = false;
+  for (const std::string& v : variants) active_listed |= v == kernels::active_variant();
+  CHECK(active_listed);
+  // Sizes below, at and above Eigen's LLT block size (the blocked path).
+  for (int n : {1, 7, 64, 300}) {
+    const Eigen::MatrixXd A = random_spd(n, 17u + n);
+    Eigen::MatrixXd B = Eigen::MatrixXd::Random(n, 3);
+    const Eigen::MatrixXd ref = A.llt().solve(B);
+    for (const std::string& v : variants) {
+      INFO("variant " << v << ", n = " << n);
+      Eigen::MatrixXd a = A;
+      a.triangularView<Eigen::StrictlyUpper>().setConstant(1e300);  // only the lower triangle is read
+      Eigen::MatrixXd x = B;
+      REQUIRE(kernels::llt_solve_with(v, a.data(), n, x.data(), 3));
+      CHECK((x - ref).norm() <= 1e-12 * ref.norm());
+      CHECK((A * x - B).norm() <= 1e-10 * B.norm());
+    }
+  }
+}
+
+TEST_CASE("dense kernels: a matrix that is not positive definite is reported, not solved") {
+  Eigen::MatrixXd A = random_spd(40, 3);
+  A(20, 20) = -1.0;
+  for (const std::string& v : kernels::supported_variants()) {
+    INFO("variant " << v);
+    Eigen::MatrixXd a = A, x = Eigen::MatrixXd::Ones(40, 2);
+    CHECK_FALSE(kernels::llt_solve_with(v, a.data(), 40, x.data(), 2));
+  }
+}
+
+TEST_CASE("dense kernels: an unknown variant is refused with the known ones named") {
+  double a = 1, b = 1;
+  CHECK_THROWS_WITH(kernels::llt_solve_with("sse9", &a, 1, &b, 1),
+                    Catch::Contains("expected one of generic") && Catch::Contains("found \"sse9\""));
+}
