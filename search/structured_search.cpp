@@ -418,6 +418,7 @@ SearchResult Structured::run() {
     double error = kInf;
   };
   const auto refit = [&](const std::vector<Term>& ts, std::vector<double>* errors) {
+    errors->clear();  // fit_homomorphic appends
     FitOptions fo = opt_.fit;
     // The joint refit: every term solved together (the schedule's solution is
     // one point of that problem, so its least-squares error is never higher).
