@@ -97,7 +97,12 @@ class Structured {
   };
   // One beam step: the configs after adding term j to each of `beam`.
   // n: terms solved jointly in this step's objective.
-  std::vector<Config> step(const std::vector<Config>& beam, int j, int n, TermRecord* rec);
+  // side: the previous k-term answer, extended greedily besides the beam (its
+  // random starts in every allowed parameterization, Powell from its `keep` best
+  // screened starts, at least one per parameterization); those extensions go to
+  // side_out, not into the beam.
+  std::vector<Config> step(const std::vector<Config>& beam, int j, int n, TermRecord* rec,
+                           const Config* side = nullptr, std::vector<Config>* side_out = nullptr);
   // Jacobi sweeps over terms [from, J): each re-searched with the others held.
   // The objective is the schedule with n terms solved jointly.
   void polish(std::vector<Term>& ts, double& value, size_t from, int sweeps, int n, TermRecord* rec);
@@ -158,8 +163,13 @@ std::vector<std::pair<Parameterization, PlaneSplit>> Structured::seeds(const std
 // One step of the beam: every config extended by every screened start; Powell
 // from the `keep` best distinct (config, start) pairs; the new beam is the best
 // refined configs plus the best unrefined seed configs (see the header).
-std::vector<Structured::Config> Structured::step(const std::vector<Config>& beam, int j, int n, TermRecord* rec) {
+std::vector<Structured::Config> Structured::step(const std::vector<Config>& beam_in, int j, int n, TermRecord* rec,
+                                                 const Config* side, std::vector<Config>* side_out) {
   const double t0 = now_seconds();
+  // The parents: the beam, then the side configuration (index S) if any.
+  const size_t S = beam_in.size();
+  std::vector<Config> beam = beam_in;
+  if (side) beam.push_back(*side);
   struct Cand {
     size_t b;      // beam config extended
     Start s;       // the start (term, value at the start)
@@ -194,7 +204,10 @@ std::vector<Structured::Config> Structured::step(const std::vector<Config>& beam
       for (const std::string& g : guesses) add(guess_rotation(g), p, true);
     for (int r = 0; r < opt_.restarts; ++r) {
       std::mt19937_64 rng(opt_.seed * 1000003ull + j * 7919ull + r);
-      add(Rotation4::random(rng), params_[r % params_.size()], false);
+      const Rotation4 R = Rotation4::random(rng);
+      if (b < S) add(R, params_[r % params_.size()], false);
+      else
+        for (Parameterization p : params_) add(R, p, false);  // the greedy search's starts, in each parameterization
     }
   }
   parallel_for(cands.size(), opt_.threads, [&](size_t i) {
@@ -215,9 +228,41 @@ std::vector<Structured::Config> Structured::step(const std::vector<Config>& beam
         return false;
     return std::isfinite(cands[i].s.value);
   };
-  std::vector<size_t> refine;
+  std::vector<size_t> refine, side_refine;
   for (size_t i : order)
-    if (static_cast<int>(refine.size()) < opt_.keep && distinct(refine, i)) refine.push_back(i);
+    if (cands[i].b < S && static_cast<int>(refine.size()) < opt_.keep && distinct(refine, i)) refine.push_back(i);
+  if (side) {
+    // The side's `keep` Powell runs: the best screened start of each
+    // parameterization, then the best others. A start the beam already refines
+    // from the same configuration counts as run (its result is in the beam).
+    size_t twin = S;
+    for (size_t b = 0; b < S && twin == S; ++b) {
+      bool same = beam[b].ts.size() == side->ts.size();
+      for (size_t i = 0; same && i < side->ts.size(); ++i)
+        same = beam[b].ts[i].p == side->ts[i].p && plane_distance(beam[b].ts[i].R, side->ts[i].R) < 1e-9;
+      if (same) twin = b;
+    }
+    std::vector<size_t> covered;  // side starts chosen, run or not
+    const auto choose = [&](size_t i) {
+      if (!distinct(covered, i)) return;
+      covered.push_back(i);
+      for (size_t k : refine)
+        if (cands[k].b == twin && cands[k].s.t.p == cands[i].s.t.p &&
+            plane_distance(cands[k].s.t.R, cands[i].s.t.R) < 0.02)
+          return;
+      side_refine.push_back(i);
+    };
+    for (Parameterization p : params_)
+      for (size_t i : order)
+        if (cands[i].b == S && cands[i].s.t.p == p && distinct(covered, i)) {
+          choose(i);
+          break;
+        }
+    for (size_t i : order)
+      if (cands[i].b == S && static_cast<int>(covered.size()) < opt_.keep) choose(i);
+  }
+  const size_t nb = refine.size();
+  refine.insert(refine.end(), side_refine.begin(), side_refine.end());
   std::vector<PowellResult> res(refine.size());
   parallel_for(refine.size(), opt_.threads, [&](size_t k) {
     const Cand& c = cands[refine[k]];
@@ -227,6 +272,21 @@ std::vector<Structured::Config> Structured::step(const std::vector<Config>& beam
     evaluations_ += r.evaluations;
     rec->evaluations += r.evaluations;
   }
+  if (side_out) {
+    side_out->clear();
+    for (size_t k = nb; k < refine.size(); ++k) {
+      Config c;
+      c.ts = side->ts;
+      c.ts.push_back(Term{res[k].best.normalized(), cands[refine[k]].s.t.p});
+      c.value = schedule(c.ts, &c.done, n);
+      c.start = cands[refine[k]].s.index;
+      ++evaluations_;
+      ++rec->evaluations;
+      if (std::isfinite(c.value)) side_out->push_back(std::move(c));
+    }
+  }
+  refine.resize(nb);
+  res.resize(nb);
   // New beam: refined configs first (best ceil(B/2)), then unrefined seed
   // configs (the planes read off the data, kept even when a single term
   // refined elsewhere fits better: the trap of the greedy search), then
@@ -244,7 +304,7 @@ std::vector<Structured::Config> Structured::step(const std::vector<Config>& beam
   std::stable_sort(refined.begin(), refined.end(), [](const Next& a, const Next& b) { return a.value < b.value; });
   std::vector<size_t> taken_seeds;
   for (size_t i : order) {
-    if (!distinct(taken_seeds, i)) continue;
+    if (cands[i].b >= S || !distinct(taken_seeds, i)) continue;
     taken_seeds.push_back(i);
     (cands[i].seed ? seeds_next : others).push_back({cands[i].b, cands[i].s.t, cands[i].s.value, cands[i].s.index});
   }
@@ -269,7 +329,7 @@ std::vector<Structured::Config> Structured::step(const std::vector<Config>& beam
   // Every parent configuration (best first) keeps its best seed or guess
   // extension, so a good partial configuration is not crowded out by the
   // extensions of another one.
-  for (size_t b = 0; b < beam.size(); ++b)
+  for (size_t b = 0; b < S; ++b)
     for (const Next& x : seeds_next)
       if (x.b == b) {
         take(x, B);
@@ -351,15 +411,55 @@ SearchResult Structured::run() {
   std::vector<Config> beam(1);
   beam[0].value = kInf;
   std::vector<TermRecord> records;
-  std::shared_ptr<HomomorphicFactorization> f;
-  std::vector<double> errors;
-  const auto refit = [&](const std::vector<Term>& ts) {
-    errors.clear();
+  // A k-term answer: its terms, their refit at texture_size and its error.
+  struct Answer {
+    std::vector<Term> ts;
+    std::shared_ptr<HomomorphicFactorization> f;
+    double error = kInf;
+  };
+  const auto refit = [&](const std::vector<Term>& ts, std::vector<double>* errors) {
+    errors->clear();  // fit_homomorphic appends
     FitOptions fo = opt_.fit;
     // The joint refit: every term solved together (the schedule's solution is
     // one point of that problem, so its least-squares error is never higher).
     if (opt_.final_joint) fo.solve_last = std::max(fo.solve_last, static_cast<int>(ts.size()));
-    f = fit_homomorphic(d_, specs(ts, opt_.texture_size), fo, "search", &errors);
+    return fit_homomorphic(d_, specs(ts, opt_.texture_size), fo, "search", errors);
+  };
+  const auto answer_of = [&](const std::vector<Term>& ts) {
+    Answer a;
+    a.ts = ts;
+    std::vector<double> errors;
+    try {
+      a.f = refit(ts, &errors);
+      a.error = errors.back();
+    } catch (const std::runtime_error&) {
+      a.f = nullptr;
+    }
+    return a;
+  };
+  // The best k-term configuration of stage k: every configuration of the beam
+  // refit at texture_size (in parallel), the lowest error kept. The beam's order
+  // is the search objective's (search resolution, schedule); its best need not
+  // be the best refit, and the final answer's k-term prefix was chosen for the
+  // final count, so each k has its own answer (out.answers).
+  // Besides the beam, each k-term answer is extended greedily (step's side
+  // configuration): the greedy search's own starts from it, so a k-term answer
+  // the greedy search reaches by extending its (k-1)-term answer is in reach.
+  std::vector<Answer> stage_best;
+  std::vector<Config> side_next;
+  Config side;  // the last answer at the search resolution (the schedule's texels); first the empty one
+  const auto keep_stage_best = [&] {
+    std::vector<const Config*> all;
+    for (const Config& c : beam) all.push_back(&c);
+    for (const Config& c : side_next) all.push_back(&c);
+    std::vector<Answer> as(all.size());
+    parallel_for(all.size(), opt_.threads, [&](size_t b) { as[b] = answer_of(all[b]->ts); });
+    evaluations_ += static_cast<int>(all.size());
+    size_t best = 0;
+    for (size_t b = 1; b < as.size(); ++b)
+      if (as[b].error < as[best].error) best = b;
+    side = *all[best];
+    stage_best.push_back(std::move(as[best]));
   };
   // Small searches are polished and refitted under the joint objective (all
   // terms solved together); their last term is searched under it too (the
@@ -369,18 +469,21 @@ SearchResult Structured::run() {
                           : opt_.fit.solve_last;
   for (int j = 0; j < opt_.terms; ++j) {
     TermRecord rec;
-    std::vector<Config> next = step(beam, j, j + 1 == opt_.terms ? n_final : opt_.fit.solve_last, &rec);
+    const int nj = j + 1 == opt_.terms ? n_final : opt_.fit.solve_last;
+    std::vector<Config> next = step(beam, j, nj, &rec, &side, &side_next);
     if (next.empty()) throw std::runtime_error("structured search: every start of term " + std::to_string(j + 1) +
                                                " failed to solve");
     beam = std::move(next);
     rec.rotation = beam[0].ts.back().R.packed();
     rec.search_rel_mse = beam[0].value;
     rec.best_start = beam[0].start;
+    const double t1 = now_seconds();
+    keep_stage_best();
+    rec.seconds += now_seconds() - t1;
     records.push_back(rec);
-    if (opt_.stop_after_term && j + 1 < opt_.terms) {
-      refit(beam[0].ts);
-      if (opt_.stop_after_term(*f)) break;
-    }
+    if (opt_.stop_after_term && j + 1 < opt_.terms && stage_best.back().f &&
+        opt_.stop_after_term(*stage_best.back().f))
+      break;
   }
   std::vector<Term> ts = beam[0].ts;
   double value = beam[0].value;
@@ -393,14 +496,42 @@ SearchResult Structured::run() {
     const size_t from = n >= J ? 0 : static_cast<size_t>(J - n);
     polish(ts, value, from, opt_.polish_sweeps, n, &records.back());
   }
-  for (size_t i = 0; i < ts.size(); ++i) records[i].rotation = ts[i].R.packed();
+  // The k-term answers. k = J: the final (polished) configuration or stage J's
+  // best, whichever fits better at texture_size. k < J: that answer's k-term
+  // prefix, refit jointly, or stage k's best configuration, whichever fits
+  // better. The joint refit's step k solves the first k terms together, so
+  // errors[k-1] is the prefix's error.
+  std::vector<double> errors;
+  std::shared_ptr<HomomorphicFactorization> final_f = refit(ts, &errors);
+  ++evaluations_;
+  std::vector<Term> answer_ts = ts;
+  if (stage_best[J - 1].error < errors.back()) {
+    answer_ts = stage_best[J - 1].ts;
+    final_f = refit(answer_ts, &errors);
+    ++evaluations_;
+  }
+  out.answers.resize(J);
+  out.rel_mse_after_term.resize(J);
+  out.answers[J - 1] = final_f;
+  out.rel_mse_after_term[J - 1] = errors[J - 1];
+  for (int k = J - 1; k >= 1; --k) {
+    const Answer& sb = stage_best[k - 1];
+    if (sb.error < errors[k - 1]) {
+      out.answers[k - 1] = sb.f;
+      out.rel_mse_after_term[k - 1] = sb.error;
+    } else {
+      const Answer a = answer_of(std::vector<Term>(answer_ts.begin(), answer_ts.begin() + k));
+      ++evaluations_;
+      out.answers[k - 1] = a.f;
+      out.rel_mse_after_term[k - 1] = a.error;
+    }
+  }
+  for (size_t i = 0; i < answer_ts.size(); ++i) records[i].rotation = answer_ts[i].R.packed();
   records.back().search_rel_mse = value;
-  refit(ts);
-  out.factorization = f;
-  out.rel_mse_after_term = errors;
+  out.factorization = out.answers.back();
   out.terms = records;
   out.search_rel_mse = value;
-  out.beam_rel_mse = {errors.back()};
+  out.beam_rel_mse = {out.rel_mse_after_term.back()};
   out.evaluations = evaluations_;
   out.seconds = now_seconds() - t0;
   return out;

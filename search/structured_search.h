@@ -27,6 +27,14 @@
 //    polish under that joint objective (the schedule's n = 2 solve cannot
 //    reach McCool's error on a BRDF of exactly McCool's form even at the true
 //    planes).
+//  - k-term answers: after term k, every configuration of the beam is refit
+//    at texture_size and the best is stage k's answer; besides the beam, that
+//    answer is extended greedily (its random starts in each parameterization,
+//    Powell from the `keep` best screened ones, at least one per
+//    parameterization), and those extensions compete for the next answer.
+//    SearchResult::answers[k-1] is the better of stage k's answer and the final
+//    answer's k-term prefix (refit jointly), so a 1- or 2-term answer is not
+//    bound to the terms chosen for the final count.
 // The screening and Powell objective is the greedy search's: the schedule's
 // least-squares error at the search texture size (n = solve_last).
 #pragma once

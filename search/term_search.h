@@ -91,7 +91,15 @@ struct TermRecord {
 struct SearchResult {
   std::shared_ptr<HomomorphicFactorization> factorization;  // at texture_size
   std::vector<TermRecord> terms;
-  std::vector<double> rel_mse_after_term;  // at texture_size, fit data
+  // At texture_size, fit data: element k-1 is the error of the k-term answer.
+  // Greedy: the k-term prefix of `factorization` (the schedule's step k).
+  // Structured: answers[k-1], which need not be a prefix of `factorization`.
+  std::vector<double> rel_mse_after_term;
+  // Structured only: the k-term answer for every k = 1..terms (answers.back()
+  // is `factorization`): the better of the final configuration's k-term prefix
+  // and the best configuration the beam held after term k, refit jointly at
+  // texture_size. Empty for the greedy search (its k-term answer is the prefix).
+  std::vector<std::shared_ptr<HomomorphicFactorization>> answers;
   double search_rel_mse = 0;               // final objective at the search resolution
   std::vector<double> beam_rel_mse;        // final error (texture_size) of each beam branch
   int best_branch = 0;                     // the winning branch (0 = the greedy one)

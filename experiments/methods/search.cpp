@@ -263,6 +263,23 @@ class SearchKind final : public HomomorphicKind {
     run.errors_after_term = sr.rel_mse_after_term;
     MethodOutcome out = finish_homomorphic(c, std::move(run), std::move(chosen), sr.evaluations);
     out.record["terms"] = term_records(sr);
+    // The structured search's k-term answers (errors_after_term[k-1] is the
+    // error of answers[k-1], which need not be a prefix of the row's factorization).
+    if (!sr.answers.empty()) {
+      json answers = json::array();
+      for (size_t k = 0; k < sr.answers.size(); ++k) {
+        json params = json::array(), rotations = json::array();
+        for (const FactorTerm& t : sr.answers[k]->terms()) {
+          params.push_back(to_string(t.proj.param));
+          rotations.push_back(t.rotation ? json(*t.rotation) : json());
+        }
+        answers.push_back({{"terms", k + 1},
+                           {"rel_mse", sr.rel_mse_after_term[k]},
+                           {"parameterizations", params},
+                           {"rotations", rotations}});
+      }
+      out.record["answers"] = answers;
+    }
     if (sr.beam_rel_mse.size() > 1) {
       out.record["beam_rel_mse"] = sr.beam_rel_mse;
       out.record["best_branch"] = sr.best_branch;
