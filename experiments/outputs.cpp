@@ -41,7 +41,9 @@ const std::vector<std::string>& result_columns() {
   static const std::vector<std::string> c = [] {
     std::vector<std::string> v = required_columns();
     for (const char* e : {"label", "sampling", "sweep", "seed", "status", "errors_after_term", "negative_texels",
-                          "order", "view_order", "tolerance", "tolerance_reached", "shade_rmse", "isotropic",
+                          "order", "view_order", "tolerance", "tolerance_reached", "shade_rmse", "val_rel_mse",
+                          "val_cos_rmse", "val_max_ratio", "holdout_rel_mse", "holdout_cos_rmse", "validation",
+                          "flag", "isotropic",
                           "refine", "refine_seconds", "rel_mse_before", "rel_mae_before", "rel_max_before",
                           "lin_rmse_before", "lin_mae_before", "lin_max_before", "cos_rmse_before", "model",
                           "notes"})
@@ -54,7 +56,8 @@ const std::vector<std::string>& result_columns() {
 std::vector<std::string> display_columns(const std::vector<RunEntry>& runs) {
   std::vector<std::string> cols = required_columns();
   cols.insert(cols.begin() + 3, "label");
-  for (const char* extra : {"order", "view_order", "tolerance", "tolerance_reached", "shade_rmse", "refine",
+  for (const char* extra : {"order", "view_order", "tolerance", "tolerance_reached", "shade_rmse", "val_rel_mse",
+                            "val_cos_rmse", "val_max_ratio", "holdout_rel_mse", "holdout_cos_rmse", "flag", "refine",
                             "refine_seconds", "rel_mse_before", "lin_rmse_before", "cos_rmse_before", "seed",
                             "sampling", "sweep", "model", "notes"})
     for (const auto& r : runs) {
