@@ -22,6 +22,7 @@
 
 #include "experiments/cli_util.h"
 #include "experiments/report.h"
+#include "experiments/validation.h"
 #include "factor/image_io.h"
 
 namespace bf {
@@ -280,6 +281,11 @@ void write_results_md(const ExperimentOutput& e, const OutputFiles& f, const std
     o << "\n- seed: " << x.value("seed", json(1)).dump() << " (per-run seeds in manifest.json)\n";
     o << "- errors: docs/design.md §4 on each run's samples (log transform eps "
       << x.value("metric_eps", json(1e-5)).dump() << "); `seconds` is the method's wall time\n";
+    o << "- validation: `val_*` on a stratified whole-domain set against the BRDF (measured: its interpolant), "
+         "`holdout_*` on raw samples held out of the fit, `shade_rmse` in the scene (docs/design.md §4.1); "
+         "`flag`: validation error > "
+      << format_number(kFlagErrorFactor) << "x training and > " << format_number(kFlagErrorFloor)
+      << ", or `val_max_ratio` > " << format_number(kFlagMaxRatio) << " (reason in notes)\n";
     o << "- files: [results.csv](results.csv) (full precision and extra columns), "
          "[manifest.json](manifest.json), [report.html](report.html)\n\n";
     const std::vector<std::string> cols = display_columns(e.runs);
