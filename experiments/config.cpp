@@ -39,7 +39,9 @@ namespace fs = std::filesystem;
 using nlohmann::json;
 
 // Bump when the meaning of a run's outputs changes, so old caches are not reused.
-constexpr int kRunFormatVersion = 1;
+// 2: every run is scored on a validation set and by the default scene, and
+// runs on measured/file samples are trained without their held-out samples.
+constexpr int kRunFormatVersion = 2;
 
 ConfigError::ConfigError(std::vector<std::string> messages)
     : std::invalid_argument([&] {
@@ -71,9 +73,15 @@ std::string file_hash(const std::string& path) {
 
 std::string short_hash(const json& j) { return content_hash(j.dump()).substr(0, 12); }
 
+uint64_t validation_seed(uint64_t experiment_seed) {
+  // FNV-1a of a fixed tag and the seed: unrelated to the sampling and method
+  // seeds (which are experiment.seed itself by default).
+  return std::stoull(content_hash("validation:" + std::to_string(experiment_seed)).substr(0, 12), nullptr, 16);
+}
+
 nlohmann::json SceneSettings::identity() const {
   nlohmann::json j = {{"light", {light.x(), light.y(), light.z()}}, {"intensity", intensity}, {"size", size},
-                      {"shade_rmse", named}};
+                      {"shade_rmse", shade}};
   // Only SH-lit scenes carry the lighting (point-lit run ids are unchanged).
   if (lighting) {
     j["lighting"] = {{"source", environment.empty() ? "directional" : "env"},
@@ -94,9 +102,9 @@ const std::map<std::string, std::vector<std::string>>& key_table() {
   static const std::map<std::string, std::vector<std::string>> t = {
       {"top", {"experiment", "brdf", "sampling", "method", "scene"}},
       {"experiment", {"name", "seed", "out", "description", "jobs", "plots", "render", "export",
-                      "metric_eps"}},
+                      "metric_eps", "validation_pairs", "holdout"}},
       {"sampling", {"kind", "resolution", "count", "seed", "path", "zip"}},
-      {"scene", {"light", "intensity", "size", "environment", "environment_eps", "lighting_order",
+      {"scene", {"shade_rmse", "light", "intensity", "size", "environment", "environment_eps", "lighting_order",
                  "lighting_nodes"}},
       {"brdf", {"preset", "model", "file", "name", "zip"}},
       {"projection", {"parameterization", "matrix", "name", "reciprocal"}},
@@ -144,6 +152,8 @@ ExperimentSettings read_experiment(const toml::table* t, Ctx& ctx, const std::st
   e.render = r.boolean("render", true);
   e.export_factors = r.boolean("export", true);
   e.metric_eps = r.number("metric_eps", 1e-5, 0.0, 1.0, true);
+  e.validation_pairs = static_cast<int>(r.integer("validation_pairs", e.validation_pairs, 0, 1000000));
+  e.holdout = r.number("holdout", e.holdout, 0.0, 0.5, false);
   r.finish(config_keys("experiment"), "[experiment]");
   return e;
 }
@@ -154,6 +164,7 @@ SceneSettings read_scene(const toml::table* t, Ctx& ctx) {
   s.named = true;
   const Combo c = plain_combo(*t);
   Reader r(ctx, c, "scene", ctx.where(*t));
+  s.shade = r.boolean("shade_rmse", true);
   if (const toml::node* n = r.take("light")) {
     auto a = n->as_array();
     bool ok = a && a->size() == 3;
@@ -634,6 +645,18 @@ Plan parse_plan(const std::string& text, const std::string& path, const std::vec
   // Rules of each method about the rest of the plan (methods/: scene lighting, BRDFs).
   for (auto& m : plan.methods) m.impl->check_plan(plan, m, ctx);
 
+  // Tolerances on metrics scored outside the fit's samples need their source.
+  for (const auto& m : plan.methods) {
+    if (!m.tolerance) continue;
+    if (m.tolerance->metric == "shade_rmse" && !plan.scene.shade)
+      ctx.issue(m.where, "tolerance.metric",
+                "metric = \"shade_rmse\" needs the scene's shade_rmse, but [scene] shade_rmse = false");
+    if (m.tolerance->metric.rfind("val_", 0) == 0 && plan.experiment.validation_pairs == 0)
+      ctx.issue(m.where, "tolerance.metric",
+                "metric = \"" + m.tolerance->metric +
+                    "\" is scored on the validation set, but [experiment] validation_pairs = 0 (no set)");
+  }
+
   // Combinations that need a measured BRDF.
   for (const auto& s : plan.samplings) {
     if (s.kind != "measured") continue;
@@ -649,7 +672,10 @@ Plan parse_plan(const std::string& text, const std::string& path, const std::vec
                        {"metric_eps", plan.experiment.metric_eps},
                        {"render", plan.experiment.render},
                        {"export", plan.experiment.export_factors},
-                       {"scene", plan.scene.identity()}};
+                       {"scene", plan.scene.identity()},
+                       {"validation", {{"pairs", plan.experiment.validation_pairs},
+                                       {"holdout", plan.experiment.holdout},
+                                       {"seed", validation_seed(plan.experiment.seed)}}}};
   std::set<std::string> ids;
   json all = json::array();
   for (size_t b = 0; b < plan.brdfs.size(); ++b)

@@ -49,15 +49,26 @@ struct ExperimentSettings {
   bool render = true;       // per run: sphere picture (original | approximation | error)
   bool export_factors = true;  // per run: factor textures, sidecar, GLSL (config key `export`)
   double metric_eps = 1e-5; // eps of the log transform every method is scored with (docs/design.md §4)
+  // Validation (docs/design.md §4 "validation"): stratified pairs over the
+  // whole hemisphere pair scored against the BRDF (0 = none), and the
+  // fraction of measured/file samples held out of the fit.
+  int validation_pairs = 4096;
+  double holdout = 0.1;
 };
 
-// [scene]: the picture of every run; when the table is present, also the
-// shade_rmse column (docs/design.md §4). A unit sphere at the origin seen by an
+// The seed of the validation set and of the held-out choice, derived from
+// experiment.seed (independent of every sampling and method seed).
+uint64_t validation_seed(uint64_t experiment_seed);
+
+// [scene]: the picture of every run and the shade_rmse column (docs/design.md
+// §4), with the defaults below when the config has no [scene] (the default
+// scene); `shade_rmse = false` drops the column. A unit sphere at the origin seen by an
 // orthographic camera on +z, lit by one point light, or by band-limited SH
 // lighting (factor/lighting.h) when `environment` or `lighting_order` is set;
 // the SH lighting's order then caps the orders of sh-k and sh-r.
 struct SceneSettings {
   bool named = false;             // the config has a [scene] table
+  bool shade = true;              // key shade_rmse: the shade_rmse column (default scene when no [scene])
   Vec3 light = Vec3(2.0, 2.0, 4.0);  // light position (world; sphere radius 1)
   double intensity = 20.0;        // radiance = intensity * f * cos(theta_i) / distance^2
   int size = 128;                 // pixels per panel edge

@@ -770,7 +770,8 @@ std::optional<Tolerance> read_tolerance(Reader& r, json& o) {
   Reader tr(r.ctx(), c, r.field("tolerance"), r.ctx().where(*n));
   Tolerance tol;
   tol.metric = tr.choice("metric", "rel_mse",
-                         {"rel_mse", "rel_mae", "rel_max", "lin_rmse", "lin_mae", "lin_max", "cos_rmse"});
+                         {"rel_mse", "rel_mae", "rel_max", "lin_rmse", "lin_mae", "lin_max", "cos_rmse",
+                          "shade_rmse", "val_rel_mse", "val_cos_rmse", "val_max_ratio"});
   if (!tr.has("value")) tr.fail_table("needs value = <error target > 0>");
   tol.value = tr.number("value", 1.0, 0.0, kInf, true);
   tr.finish(tolerance_keys(), "tolerance");

@@ -22,6 +22,7 @@
 
 #include "experiments/cli_util.h"
 #include "experiments/report.h"
+#include "experiments/validation.h"
 #include "factor/image_io.h"
 
 namespace bf {
@@ -41,7 +42,9 @@ const std::vector<std::string>& result_columns() {
   static const std::vector<std::string> c = [] {
     std::vector<std::string> v = required_columns();
     for (const char* e : {"label", "sampling", "sweep", "seed", "status", "errors_after_term", "negative_texels",
-                          "order", "view_order", "tolerance", "tolerance_reached", "shade_rmse", "isotropic",
+                          "order", "view_order", "tolerance", "tolerance_reached", "shade_rmse", "val_rel_mse",
+                          "val_cos_rmse", "val_max_ratio", "holdout_rel_mse", "holdout_cos_rmse", "validation",
+                          "flag", "isotropic",
                           "refine", "refine_seconds", "rel_mse_before", "rel_mae_before", "rel_max_before",
                           "lin_rmse_before", "lin_mae_before", "lin_max_before", "cos_rmse_before", "model",
                           "notes"})
@@ -54,7 +57,8 @@ const std::vector<std::string>& result_columns() {
 std::vector<std::string> display_columns(const std::vector<RunEntry>& runs) {
   std::vector<std::string> cols = required_columns();
   cols.insert(cols.begin() + 3, "label");
-  for (const char* extra : {"order", "view_order", "tolerance", "tolerance_reached", "shade_rmse", "refine",
+  for (const char* extra : {"order", "view_order", "tolerance", "tolerance_reached", "shade_rmse", "val_rel_mse",
+                            "val_cos_rmse", "val_max_ratio", "holdout_rel_mse", "holdout_cos_rmse", "flag", "refine",
                             "refine_seconds", "rel_mse_before", "lin_rmse_before", "cos_rmse_before", "seed",
                             "sampling", "sweep", "model", "notes"})
     for (const auto& r : runs) {
@@ -277,6 +281,11 @@ void write_results_md(const ExperimentOutput& e, const OutputFiles& f, const std
     o << "\n- seed: " << x.value("seed", json(1)).dump() << " (per-run seeds in manifest.json)\n";
     o << "- errors: docs/design.md §4 on each run's samples (log transform eps "
       << x.value("metric_eps", json(1e-5)).dump() << "); `seconds` is the method's wall time\n";
+    o << "- validation: `val_*` on a stratified whole-domain set against the BRDF (measured: its interpolant), "
+         "`holdout_*` on raw samples held out of the fit, `shade_rmse` in the scene (docs/design.md §4.1); "
+         "`flag`: validation error > "
+      << format_number(kFlagErrorFactor) << "x training and > " << format_number(kFlagErrorFloor)
+      << ", or `val_max_ratio` > " << format_number(kFlagMaxRatio) << " (reason in notes)\n";
     o << "- files: [results.csv](results.csv) (full precision and extra columns), "
          "[manifest.json](manifest.json), [report.html](report.html)\n\n";
     const std::vector<std::string> cols = display_columns(e.runs);

@@ -21,7 +21,9 @@ inline constexpr const char* kBrdfFactorVersion = "0.1.0";
 const std::vector<std::string>& required_columns();
 // ...then the extras: label, sampling, sweep, seed, status, errors_after_term,
 // negative_texels, order, view_order, tolerance, tolerance_reached,
-// shade_rmse, refine, refine_seconds, <metric>_before (the 7 metrics of the
+// shade_rmse, val_rel_mse, val_cos_rmse, val_max_ratio, holdout_rel_mse,
+// holdout_cos_rmse, validation, flag (experiments/validation.h), isotropic,
+// refine, refine_seconds, <metric>_before (the 7 metrics of the
 // fit before refinement), model, notes (docs/experiments.md says what each holds).
 const std::vector<std::string>& result_columns();
 

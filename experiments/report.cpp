@@ -50,7 +50,7 @@ body{font-family:system-ui,-apple-system,Segoe UI,Helvetica,Arial,sans-serif;mar
 h1{font-size:1.6em}h2{font-size:1.25em;margin-top:2em;border-bottom:1px solid #ddd}
 table{border-collapse:collapse;font-size:0.82em}td,th{border:1px solid #ccc;padding:2px 6px;text-align:right}
 th{background:#f0f0f0;position:sticky;top:0}td.t{text-align:left}tr.failed td{background:#fde8e8}
-td.best,span.best{font-weight:bold;background:#dff3df}.tablewrap{overflow-x:auto;max-width:100%}p.note{font-size:0.85em;color:#555}
+tr.flagged td{background:#fff3e0}td.best,span.best{font-weight:bold;background:#dff3df}.tablewrap{overflow-x:auto;max-width:100%}p.note{font-size:0.85em;color:#555}
 .plots img{max-width:45%;margin:0.5em;border:1px solid #ddd}
 .run{border:1px solid #ddd;border-radius:6px;padding:0.6em 1em;margin:1em 0}
 .run img.sphere{max-width:100%;image-rendering:pixelated}.run img.tex{height:96px;margin-right:4px;image-rendering:pixelated}
@@ -70,7 +70,8 @@ bool exists_in(const std::string& dir, const std::string& rel) {
 
 std::vector<std::string> key_columns_first(const std::vector<std::string>& cols) {
   static const std::vector<std::string> key = {"brdf",          "method",  "label",      "rel_mse",
-                                               "cos_rmse",      "shade_rmse", "storage_floats",
+                                               "cos_rmse",      "shade_rmse", "val_rel_mse", "val_cos_rmse",
+                                               "val_max_ratio", "holdout_rel_mse", "flag", "storage_floats",
                                                "seconds",       "evaluations"};
   std::vector<std::string> out;
   for (const auto& k : key)
@@ -82,7 +83,8 @@ std::vector<std::string> key_columns_first(const std::vector<std::string>& cols)
 
 bool is_marked_column(const std::string& c) {
   static const std::set<std::string> m = {"rel_mse", "rel_mae", "rel_max", "lin_rmse", "lin_mae", "lin_max",
-                                          "cos_rmse", "shade_rmse", "storage_floats", "seconds"};
+                                          "cos_rmse", "shade_rmse", "val_rel_mse", "val_cos_rmse", "val_max_ratio",
+                                          "holdout_rel_mse", "holdout_cos_rmse", "storage_floats", "seconds"};
   return m.count(c) > 0;
 }
 
@@ -146,20 +148,25 @@ void write_report_html(const ExperimentOutput& e, const OutputFiles& f, const st
 
   // Results table.
   h << "<h2>Results</h2>\n<p class=\"note\">Key columns first. <span class=\"best\">Green bold</span>: "
-       "the best (lowest) value of that column among the runs of the same BRDF.</p>\n"
+       "the best (lowest) value of that column among the runs of the same BRDF. Orange rows are flagged "
+       "(validation error far above the training error, or values far above the BRDF's peak): the reason "
+       "is in notes.</p>\n"
        "<div class=\"tablewrap\"><table><tr>";
   const std::vector<std::string> cols = display_columns(e.runs);
   const auto marked = best_cells(e.runs, cols);
   for (const auto& c : cols) h << "<th>" << esc(c) << "</th>";
   h << "</tr>\n";
   for (const auto& r : e.runs) {
-    h << "<tr" << (r.status != "ok" ? " class=\"failed\"" : "") << ">";
+    const auto fl = r.row.find("flag");
+    const bool flagged = fl != r.row.end() && !fl->second.empty();
+    h << "<tr" << (r.status != "ok" ? " class=\"failed\"" : flagged ? " class=\"flagged\" title=\"flagged: see notes\"" : "")
+      << ">";
     for (const auto& c : cols) {
       auto it = r.row.find(c);
       const std::string cell = it == r.row.end() ? "" : it->second;
       const bool text = c == "run_id" || c == "brdf" || c == "method" || c == "label" || c == "parameterization" ||
                         c == "sampling" || c == "notes" || c == "reciprocity" || c == "sweep" ||
-                        c == "tolerance";
+                        c == "tolerance" || c == "flag";
       const bool best = marked.count({size_t(&r - e.runs.data()), c}) > 0;
       h << "<td" << (text ? " class=\"t\"" : best ? " class=\"best\" title=\"best " + esc(c) + " of this BRDF\"" : "")
         << ">";

@@ -30,6 +30,7 @@
 #include "experiments/sample_cache.h"
 #include "experiments/preflight.h"
 #include "experiments/methods/method_kind.h"
+#include "experiments/validation.h"
 #include "experiments/viewer.h"
 #include "solvers/cancel.h"
 #include "factor/isotropy.h"
@@ -77,7 +78,8 @@ std::string describe_run(const Plan& plan, const PlannedRun& r) {
          describe_method(plan.methods[r.method]);
 }
 
-// Original-BRDF renders are shared by every run of a BRDF.
+// Original-BRDF renders and whole-domain validation sets are shared by every
+// run of a BRDF.
 class RenderCache {
  public:
   std::shared_ptr<const SphereRender> get(const Plan& plan, size_t brdf) {
@@ -86,11 +88,61 @@ class RenderCache {
     if (!slot) slot = std::make_shared<SphereRender>(render_sphere(*plan.brdfs[brdf].brdf, plan.scene));
     return slot;
   }
+  // nullptr when experiment.validation_pairs = 0.
+  std::shared_ptr<const SampleSet> validation(const Plan& plan, size_t brdf) {
+    if (plan.experiment.validation_pairs <= 0) return nullptr;
+    std::unique_lock<std::mutex> lk(mu_);
+    auto& slot = sets_[brdf];
+    if (!slot)
+      slot = std::make_shared<SampleSet>(validation_set(*plan.brdfs[brdf].brdf, plan.experiment.validation_pairs,
+                                                        validation_seed(plan.experiment.seed)));
+    return slot;
+  }
 
  private:
   std::mutex mu_;
   std::map<size_t, std::shared_ptr<const SphereRender>> map_;
+  std::map<size_t, std::shared_ptr<const SampleSet>> sets_;
 };
+
+// The validation scheme of a run, in words (the `validation` column).
+std::string validation_scheme(const Plan& plan, const BrdfVariant& b, const SampleSet* domain,
+                              const HoldoutSplit* split, size_t all_valid) {
+  std::vector<std::string> parts;
+  if (domain)
+    parts.push_back("domain: " + std::to_string(domain->size()) + " stratified pairs (seed " +
+                    std::to_string(validation_seed(plan.experiment.seed)) + ") vs the " +
+                    (b.measured ? "interpolant" : "BRDF"));
+  if (split)
+    parts.push_back("held out: " + std::to_string(split->held.valid_count()) + " of " + std::to_string(all_valid) +
+                    " samples (" + format_number(plan.experiment.holdout * 100.0) + "%), not fitted");
+  return join(parts, "; ");
+}
+
+// With a tolerance on a metric not scored on the fit's samples (shade_rmse,
+// val_*: factor/size_choice.h), the method's copy with the scorer set: every
+// kind's selection then judges candidates by the scene or the validation set.
+MethodVariant with_tolerance_scorer(const MethodVariant& m, const Plan& plan, const PlannedRun& pr,
+                                    RenderCache& renders, std::shared_ptr<const SampleSet> domain,
+                                    const LogTransform& lt) {
+  MethodVariant mv = m;
+  if (!mv.tolerance || !is_external_metric(mv.tolerance->metric)) return mv;
+  const std::string metric = mv.tolerance->metric;
+  if (metric == "shade_rmse") {
+    std::shared_ptr<const SphereRender> original = renders.get(plan, pr.brdf);
+    const SceneSettings scene = plan.scene;
+    mv.tolerance->score = [original, scene](const Brdf& cand) {
+      return shade_rmse(*original, render_sphere(cand, scene));
+    };
+  } else {
+    if (!domain) throw std::runtime_error("tolerance " + metric + " needs a validation set (validation_pairs > 0)");
+    mv.tolerance->score = [domain, lt, metric](const Brdf& cand) {
+      const ValidationScores v = score_validation(cand, domain.get(), nullptr, lt);
+      return metric == "val_max_ratio" ? v.max_ratio : metric_value(v.val, metric.substr(4));
+    };
+  }
+  return mv;
+}
 
 std::vector<std::string> list_files(const fs::path& exp_dir, const fs::path& run_dir) {
   std::vector<std::string> files;
@@ -185,8 +237,7 @@ json run_record(const Plan& plan, const PlannedRun& pr, const SampleSet& samples
 RunEntry execute_run(const Plan& plan, const PlannedRun& pr, const SampleSet& samples, const fs::path& exp_dir,
                      RenderCache& renders, const json& build) {
   const BrdfVariant& b = plan.brdfs[pr.brdf];
-  const MethodVariant& m = plan.methods[pr.method];
-  const MethodKind& kind = *m.impl;
+  const MethodKind& kind = *plan.methods[pr.method].impl;
   const fs::path run_dir = exp_dir / "runs" / pr.run_id;
   fs::remove_all(run_dir);
   fs::create_directories(run_dir);
@@ -198,39 +249,57 @@ RunEntry execute_run(const Plan& plan, const PlannedRun& pr, const SampleSet& sa
   Row& row = e.row;
   set_presentation(row, plan, pr);
   json rec = run_record(plan, pr, samples);
-  const LogTransform lt = LogTransform::of(samples, plan.experiment.metric_eps);
+  // Validation data (experiments/validation.h): raw samples lose a held-out
+  // fraction before the fit; the whole-domain set is shared by the BRDF's runs.
+  std::optional<HoldoutSplit> split;
+  if (holds_out(plan.samplings[pr.sampling], plan.experiment))
+    split = split_holdout(samples, plan.experiment.holdout, validation_seed(plan.experiment.seed));
+  const SampleSet& fit_samples = split ? split->train : samples;
+  const auto domain = renders.validation(plan, pr.brdf);
+  const LogTransform lt = LogTransform::of(fit_samples, plan.experiment.metric_eps);
+  const MethodVariant m = with_tolerance_scorer(plan.methods[pr.method], plan, pr, renders, domain, lt);
 
   // Azimuthal-invariance test of the BRDF (factor/isotropy.h): results column `isotropic`.
   const IsotropyResult isotropy = test_isotropy(*b.brdf);
   row["isotropic"] = isotropy.isotropic ? "true" : "false";
   rec["isotropy"] = isotropy.describe();
 
-  const RunContext c{plan, pr, b, m, samples, lt, isotropy, run_dir,
+  const RunContext c{plan, pr, b, m, fit_samples, lt, isotropy, run_dir,
                      [&] { return renders.get(plan, pr.brdf); }};
   const auto t0 = Clock::now();
   MethodOutcome out = kind.run(c);
   const double seconds = since(t0);
   if (!out.result) throw std::runtime_error("method " + m.kind + " returned no factorization");
-  const Metrics mt = evaluate_metrics(*out.result, samples, lt);
+  const Metrics mt = evaluate_metrics(*out.result, fit_samples, lt);
 
   // The kind's columns (the required ones empty unless it fills them), then the common ones.
   for (const char* k : {"parameterization", "reciprocity", "terms", "texture_size"}) row[k] = "";
   kind.fill_row(c, out, row);
   std::vector<std::string> notes = out.notes;
   fill_common_columns(c, out, mt, seconds, row, notes, rec);
+  {  // Validation on data the fit never saw, and its flags.
+    const auto tv = Clock::now();
+    const ValidationScores vs = score_validation(*out.result, domain.get(), split ? &split->held : nullptr, lt);
+    const std::string scheme = validation_scheme(plan, b, domain.get(), split ? &*split : nullptr,
+                                                 samples.valid_count());
+    fill_validation_columns(vs, mt.rel_mse, scheme, row, notes);
+    rec["validation"] = {{"scheme", scheme}, {"seconds", since(tv)}};
+  }
 
   if (plan.experiment.export_factors) kind.export_files(c, out);
-  if (plan.experiment.render) {
+  if (plan.experiment.render || plan.scene.shade) {
     const auto original = renders.get(plan, pr.brdf);
     const SphereRender approx = render_sphere(*out.result, plan.scene);
-    write_comparison_png(*original, approx, (run_dir / "sphere.png").string());
-    // report.html's WebGL2 viewer data (experiments/viewer.h).
-    if (plan.experiment.export_factors && viewer_supports(*out.result))
-      write_viewer_data(*out.result, *plan.brdfs[pr.brdf].brdf, *original, plan.scene, pr.run_id,
-                        plan.brdfs[pr.brdf].label + " | " + row["label"] + " " + row["sweep"],
-                        (run_dir / "viewer.js").string());
+    if (plan.experiment.render) {
+      write_comparison_png(*original, approx, (run_dir / "sphere.png").string());
+      // report.html's WebGL2 viewer data (experiments/viewer.h).
+      if (plan.experiment.export_factors && viewer_supports(*out.result))
+        write_viewer_data(*out.result, *plan.brdfs[pr.brdf].brdf, *original, plan.scene, pr.run_id,
+                          plan.brdfs[pr.brdf].label + " | " + row["label"] + " " + row["sweep"],
+                          (run_dir / "viewer.js").string());
+    }
     if (approx.nonfinite) notes.push_back(std::to_string(approx.nonfinite) + " non-finite pixels rendered as 0");
-    if (plan.scene.named) row["shade_rmse"] = format_number(shade_rmse(*original, approx));
+    if (plan.scene.shade) row["shade_rmse"] = format_number(shade_rmse(*original, approx));
   }
   out.notes.clear();
   kind.extra_outputs(c, out, row);

@@ -104,6 +104,28 @@ Metrics evaluate_metrics(const Brdf& approx, const SampleSet& s, const LogTransf
   return m;
 }
 
+double peak_ratio(const Brdf& approx, const SampleSet& s) {
+  Rgb peak = Rgb::Zero();
+  size_t n = 0;
+  for (size_t k = 0; k < s.size(); ++k)
+    if (s.valid[k]) {
+      ++n;
+      for (int c = 0; c < 3; ++c) peak[c] = std::max(peak[c], s.value[k][c]);
+    }
+  if (n == 0) throw std::invalid_argument("peak ratio: the sample set has no valid sample");
+  double worst = 0.0;
+  for (size_t k = 0; k < s.size(); ++k) {
+    if (!s.valid[k]) continue;
+    const Rgb fa = approx.eval(s.wi[k], s.wo[k]);
+    for (int c = 0; c < 3; ++c) {
+      if (!(peak[c] > 0.0)) continue;
+      const double r = std::isfinite(fa[c]) ? std::max(fa[c], 0.0) / peak[c] : kBad;
+      worst = std::max(worst, std::isfinite(r) ? r : kBad);
+    }
+  }
+  return std::min(worst, kBad);
+}
+
 double metric_value(const Metrics& m, const std::string& name) {
   if (name == "rel_mse") return m.rel_mse;
   if (name == "rel_mae") return m.rel_mae;

@@ -35,6 +35,16 @@ struct Metrics {
 // valid sample or the weights sum to 0.
 Metrics evaluate_metrics(const Brdf& approx, const SampleSet& s, const LogTransform& t);
 
+// The largest ratio of the approximation to the original's peak, over the
+// valid samples of s and the three channels:
+//   max_{k,c} max(f_approx,c(k), 0) / max_k' f_c(k')
+// (the `val_max_ratio` column, docs/design.md §4 "validation"). A channel whose
+// original is 0 at every valid sample is skipped (no peak to compare with);
+// 0 when every channel is skipped. Non-finite approximation values count as
+// 1e300 and the result is capped at 1e300. 1 or less: the approximation never
+// exceeds what the BRDF reaches on this set. Throws if s has no valid sample.
+double peak_ratio(const Brdf& approx, const SampleSet& s);
+
 // The metric named `name` ("rel_mse", ..., "cos_rmse"); throws for unknown names.
 double metric_value(const Metrics& m, const std::string& name);
 

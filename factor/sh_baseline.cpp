@@ -305,7 +305,7 @@ SizeChoice select_shk_order(const Brdf& brdf, const SampleSet& samples, const Sh
     const auto fit = fit_shk(brdf, opt);
     for (int k = scored + 1; k <= F; ++k) {
       auto fk = k == F ? fit : fit->truncated(k);
-      const double e = metric_value(evaluate_metrics(*fk, samples, lt), tol.metric);
+      const double e = tol.error_of(*fk, samples, lt);
       ch.tried.push_back({k, -1, e});
       if (e < best) {
         best = e;
@@ -648,7 +648,7 @@ SizeChoice select_shr_orders_by_metric(const Brdf& brdf, const SampleSet& sample
   double best_e = std::numeric_limits<double>::infinity();
   auto score = [&](int F, int P) {
     auto f = std::make_shared<ShrFactorization>(all, F, P, opt.min_cos, 0.0, 0.0);
-    const double e = metric_value(evaluate_metrics(*f, samples, lt), tol.metric);
+    const double e = tol.error_of(*f, samples, lt);
     ch.tried.push_back({F, P, e});
     if (e < best_e) {
       best_e = e;

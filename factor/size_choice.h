@@ -4,20 +4,39 @@
 // search's stopping rule: an error target, the candidates scored, the choice.
 #pragma once
 
+#include <functional>
 #include <string>
 #include <vector>
 
+#include "brdfs/sampleset.h"
 #include "factor/factorization.h"
+#include "factor/metrics.h"
 
 namespace bf {
 
-// An error target: a metric of factor/metrics.h (metric_value names) and a value.
+// An error target: a metric of factor/metrics.h (metric_value names) and a
+// value. A metric that is not computed on the fit's own samples (shade_rmse,
+// the validation metrics val_*: external_metric_names()) is scored by `score`,
+// which the caller supplies (the experiment runner renders the scene or scores
+// the validation set); every selection goes through error_of(), so each of
+// them accepts every metric.
 struct Tolerance {
   std::string metric = "cos_rmse";
   double value = 0.0;  // > 0
-  // Throws std::invalid_argument for an unknown metric or value <= 0 / NaN.
+  // Scorer of a candidate for an external metric; empty for sample metrics.
+  std::function<double(const Brdf& candidate)> score;
+  // Throws std::invalid_argument for an unknown metric, value <= 0 / NaN, or
+  // an external metric without a scorer.
   void validate() const;
+  // The metric of `candidate`: score(candidate) when a scorer is set, else
+  // metric_value(evaluate_metrics(candidate, samples, lt), metric).
+  double error_of(const Brdf& candidate, const SampleSet& samples, const LogTransform& lt) const;
 };
+
+// Metrics a Tolerance scores through its `score` (not on the fit's samples):
+// shade_rmse, val_rel_mse, val_cos_rmse, val_max_ratio.
+const std::vector<std::string>& external_metric_names();
+bool is_external_metric(const std::string& name);
 
 // One scored candidate of a selection.
 struct SizeTrial {

@@ -37,7 +37,7 @@ SizeChoice select_homomorphic_size(const FitData& data, const SampleSet& samples
     for (int j = min_terms; j <= max_terms; ++j) {
       std::vector<double> errs;
       auto h = fit_homomorphic(data, std::vector<TermSpec>(all.begin(), all.begin() + j), opt, method, &errs);
-      const double e = metric_value(evaluate_metrics(*h, samples, lt), tol.metric);
+      const double e = tol.error_of(*h, samples, lt);
       ch.tried.push_back({j, -1, e, res});
       const bool reached = e <= tol.value;
       if (reached || !ch.result || e < ch.error) {

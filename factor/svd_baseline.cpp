@@ -342,9 +342,34 @@ std::shared_ptr<SvdFactorization> fit_svd(const Brdf& brdf, const SvdOptions& op
 
 // ---------------------------------------------------------------- selection
 
+double Tolerance::error_of(const Brdf& candidate, const SampleSet& samples, const LogTransform& lt) const {
+  if (score) {
+    const double e = score(candidate);
+    return std::isfinite(e) ? e : 1e300;  // a non-finite score never reaches a target
+  }
+  return metric_value(evaluate_metrics(candidate, samples, lt), metric);
+}
+
+const std::vector<std::string>& external_metric_names() {
+  static const std::vector<std::string> n = {"shade_rmse", "val_rel_mse", "val_cos_rmse", "val_max_ratio"};
+  return n;
+}
+
+bool is_external_metric(const std::string& name) {
+  const auto& n = external_metric_names();
+  return std::find(n.begin(), n.end(), name) != n.end();
+}
+
 void Tolerance::validate() const {
-  Metrics probe;
-  metric_value(probe, metric);  // throws naming the accepted metrics
+  if (is_external_metric(metric)) {
+    if (!score)
+      throw OptionError("tolerance", "tolerance: metric: '" + metric +
+                                         "' is scored outside the fit's samples and needs a scorer (the experiment "
+                                         "runner supplies one), found none");
+  } else {
+    Metrics probe;
+    metric_value(probe, metric);  // throws naming the accepted metrics
+  }
   if (!(value > 0.0) || !std::isfinite(value))
     throw OptionError("tolerance", "tolerance: value: expected a finite number > 0, found " +
                                 std::to_string(value));
@@ -367,7 +392,7 @@ SizeChoice select_svd_rank(const Brdf& brdf, const SampleSet& samples, const Svd
   double best = std::numeric_limits<double>::infinity();
   for (int k = 1; k <= full->rank(); ++k) {
     auto fk = full->truncated(k);
-    const double e = metric_value(evaluate_metrics(*fk, samples, lt), tol.metric);
+    const double e = tol.error_of(*fk, samples, lt);
     ch.tried.push_back({k, -1, e});
     if (e < best || !ch.result) {
       best = e;

@@ -242,7 +242,7 @@ class SearchKind final : public HomomorphicKind {
       choice.knob = "terms";
       choice.metric = m.tolerance->metric;
       so.stop_after_term = [&](const HomomorphicFactorization& hf) {
-        const double v = metric_value(evaluate_metrics(hf, c.samples, c.lt), choice.metric);
+        const double v = m.tolerance->error_of(hf, c.samples, c.lt);
         choice.tried.push_back({static_cast<int>(hf.terms().size()), -1, v});
         choice.value = static_cast<int>(hf.terms().size());
         choice.error = v;

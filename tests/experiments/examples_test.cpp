@@ -13,7 +13,8 @@ const std::vector<std::string> kExamples = {
     "quickstart",      "thesis-bluepaint", "thesis-cook-torrance", "thesis-setup",
     "thesis-measured", "parameterizations", "baselines",          "bench-fit",
     "bench-search",    "bench-baselines", "refine",   "compare-storage",
-    "sh-lighting",     "thesis-nongreedy", "thesis-bluepaint-mccool", "refine-blend", "thesis-retro", "thesis-ratio"};
+    "sh-lighting",     "thesis-nongreedy", "thesis-bluepaint-mccool", "refine-blend", "thesis-retro", "thesis-ratio",
+    "cornell-validation", "shade-tolerance"};
 
 // Runs experiments/<name>.toml with the overrides; every run must succeed.
 void run_example(const std::string& name, const std::vector<std::string>& defines, size_t expected_runs) {
@@ -78,6 +79,11 @@ TEST_CASE("examples: thesis-setup at reduced size") {
 TEST_CASE("examples: thesis-measured at reduced size") {
   run_example("thesis-measured",
               {"method.texture_size=6", "method.restarts=1", "method.terms=2", "scene.size=24"}, 15);
+}
+
+TEST_CASE("examples: cornell-validation at reduced size") {
+  run_example("cornell-validation",
+              {"method.texture_size=6", "method.restarts=1", "method.terms=2", "brdf.model=[\"krylon-blue\"]"}, 3);
 }
 
 TEST_CASE("examples: parameterizations at reduced size") {
