@@ -113,9 +113,10 @@ TEST_CASE("extrapolation: on dense data (W1) the prior leaves the fit error unch
     }
     INFO((which == 0 ? "McCool" : "2 random wiwo terms") << ": rel_mse " << mse[0] << " without the prior, "
                                                           << mse[1] << " with it");
-    // Measured: McCool 0.0759 both; random wiwo 0.07131 without, 0.07164 with
-    // (+0.46%: mask texels no grid sample reaches are pulled to the neutral
-    // value instead of continuing their neighbours, which the Laplacian feels).
+    // Measured: McCool 0.0759079 without, 0.0759081 with; random wiwo 0.0713066
+    // without, 0.0715494 with (+0.34%: mask texels no grid sample reaches now
+    // extrapolate flat instead of continuing their neighbours, which the
+    // Laplacian feels). Tolerance 1%.
     CHECK(std::abs(mse[1] - mse[0]) <= 1e-2 * mse[0]);
   }
 }
