@@ -372,7 +372,7 @@ struct BenchExtrapolationArgs {
   int restarts = 6;
   int grid = 12;
   int threads = 0;
-  std::vector<double> priors = {0.0, FitOptions{}.extrapolation_prior};
+  std::vector<double> priors = {0.0, 1.0};  // off (the default) and on
 };
 
 // The whole-domain check of bounded extrapolation (docs/results.md): each BRDF
