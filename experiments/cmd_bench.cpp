@@ -2,6 +2,7 @@
 // one JSON object per line.
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <iostream>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -10,6 +11,8 @@
 #include <thread>
 
 #include "brdfs/catalogue.h"
+#include "brdfs/measured.h"
+#include "factor/metrics.h"
 #include "brdfs/sampleset.h"
 #include "experiments/commands.h"
 #include "factor/dense_kernels.h"
@@ -367,6 +370,135 @@ void run_bench_planted(const BenchPlantedArgs& a) {
                  fits[0], fits[1], secs[0], secs[1]);
   }
 }
+
+struct BenchExtrapolationArgs {
+  std::vector<std::string> brdfs = {"krylon-blue", "garnet-red", "cayman", "acryl-blue", "mystique"};
+  int texture = 16;
+  int restarts = 6;
+  int grid = 12;
+  int threads = 0;
+  std::vector<double> priors = {0.0, 1.0};  // off (the default) and on
+};
+
+// The whole-domain check of bounded extrapolation (docs/results.md): each BRDF
+// fitted on its raw measured samples (McCool; greedy search in wiwo and in
+// halfdiff, 3 terms, whose refit after 2 terms is the 2-texture row) for each
+// extrapolation_prior, then scored over a grid^4 set of direction pairs at
+// cell centres in (cos theta_i, phi_i, cos theta_o, phi_o): max_ratio = the
+// largest approx_c / max_k f_c(k) (channel c, max over the valid raw samples),
+// over_100x = the fraction of pairs where some channel exceeds 100 x the
+// BRDF's own value there (its interpolant) plus 1e-3 x that channel's maximum.
+// rel_mse: the fit on all samples, scored on them; held_rel_mse: the same
+// method fitted on 4/5 of the valid samples, scored on the other fifth (every
+// 5th valid sample).
+void run_bench_extrapolation(const BenchExtrapolationArgs& a) {
+  if (a.grid < 1 || a.grid > 64) throw std::invalid_argument("--grid: expected 1..64, found " + std::to_string(a.grid));
+  if (a.texture < 2 || a.texture > 256)
+    throw std::invalid_argument("--texture: expected 2..256, found " + std::to_string(a.texture));
+  if (a.priors.empty()) throw std::invalid_argument("--priors: expected at least one value, found none");
+  std::vector<Vec3> dirs;
+  for (int t = 0; t < a.grid; ++t)
+    for (int p = 0; p < a.grid; ++p) {
+      const double ct = (t + 0.5) / a.grid, st = std::sqrt(1 - ct * ct), ph = 2 * M_PI * (p + 0.5) / a.grid;
+      dirs.emplace_back(st * std::cos(ph), st * std::sin(ph), ct);
+    }
+  std::fprintf(stderr, "| BRDF | method | textures | prior | rel_mse (training) | rel_mse (held out) | max approx/max(original) | pairs > 100x |\n");
+  std::fprintf(stderr, "|---|---|---:|---:|---:|---:|---:|---:|\n");
+  for (const std::string& name : a.brdfs) {
+    const BrdfPtr brdf = Catalogue::builtin().make(name);
+    const SampleSet s = measured_samples(*brdf);
+    Rgb fmax(0, 0, 0);
+    for (size_t k = 0; k < s.size(); ++k)
+      if (s.valid[k])
+        for (int c = 0; c < 3; ++c) fmax[c] = std::max(fmax[c], s.value[k][c]);
+    std::vector<Rgb> orig;
+    orig.reserve(dirs.size() * dirs.size());
+    for (const Vec3& wi : dirs)
+      for (const Vec3& wo : dirs) orig.push_back(brdf->eval(wi, wo));
+    // Held out: every 5th valid sample (the fit on the other 4/5 is scored on it).
+    SampleSet train, held;
+    for (size_t k = 0, v = 0; k < s.size(); ++k) {
+      if (!s.valid[k]) continue;
+      SampleSet& t = (v++ % 5 == 4) ? held : train;
+      t.wi.push_back(s.wi[k]);
+      t.wo.push_back(s.wo[k]);
+      t.value.push_back(s.value[k]);
+      t.valid.push_back(1);
+      if (!s.weight.empty()) t.weight.push_back(s.weight[k]);
+    }
+    const LogTransform lt = LogTransform::of(s, FitOptions{}.eps);
+    // Every factorization of the bench for one sample set, in a fixed order.
+    const auto fit_all = [&](const SampleSet& fs, double prior) {
+      std::vector<std::pair<std::string, std::shared_ptr<const HomomorphicFactorization>>> out;
+      FitOptions fo;
+      fo.extrapolation_prior = prior;
+      const FitData d(fs, fo.eps);
+      out.emplace_back("mccool", fit_homomorphic(d, mccool_terms(a.texture), fo, "mccool"));
+      for (const Parameterization param : {Parameterization::WiWo, Parameterization::HalfDiff}) {
+        SearchOptions so;
+        so.strategy = "greedy";
+        so.terms = 3;
+        so.param = param;
+        so.texture_size = a.texture;
+        so.restarts = a.restarts;
+        so.threads = a.threads;
+        so.fit = fo;
+        std::shared_ptr<HomomorphicFactorization> two;
+        so.stop_after_term = [&](const HomomorphicFactorization& f) {
+          if (f.terms().size() == 2) two = std::make_shared<HomomorphicFactorization>(f);
+          return false;
+        };
+        const SearchResult r = search_factorization(d, so);
+        const std::string method = "search " + to_string(param);
+        if (two) out.emplace_back(method, two);
+        out.emplace_back(method, r.factorization);
+      }
+      return out;
+    };
+    for (double prior : a.priors) {
+      const auto all = fit_all(s, prior);
+      const auto part = fit_all(train, prior);
+      for (size_t m = 0; m < all.size(); ++m) {
+        const Factorization& f = *all[m].second;
+        const int textures = static_cast<int>(all[m].second->terms().size());
+        double max_ratio = 0;
+        size_t over = 0, i = 0;
+        for (const Vec3& wi : dirs)
+          for (const Vec3& wo : dirs) {
+            const Rgb v = f.eval(wi, wo);
+            bool big = false;
+            for (int c = 0; c < 3; ++c) {
+              max_ratio = std::max(max_ratio, v[c] / fmax[c]);
+              big = big || v[c] > 100 * orig[i][c] + 1e-3 * fmax[c];
+            }
+            over += big;
+            ++i;
+          }
+        const Metrics mt = evaluate_metrics(f, s, lt);
+        const Metrics mh = evaluate_metrics(*part[m].second, held, lt);
+        nlohmann::json j;
+        j["bench"] = "extrapolation";
+        j["brdf"] = name;
+        j["samples"] = mt.samples;
+        j["method"] = all[m].first;
+        j["textures"] = textures;
+        j["texture_size"] = a.texture;
+        j["restarts"] = a.restarts;
+        j["extrapolation_prior"] = prior;
+        j["rel_mse"] = mt.rel_mse;
+        j["held_rel_mse"] = mh.rel_mse;
+        j["held_samples"] = mh.samples;
+        j["max_ratio"] = max_ratio;
+        j["over_100x"] = double(over) / double(i);
+        j["grid"] = a.grid;
+        std::cout << j.dump() << std::endl;
+        std::fprintf(stderr, "| %s | %s | %d | %g | %.4g | %.4g | %.3g | %.1f%% |\n", name.c_str(),
+                     all[m].first.c_str(), textures, prior, mt.rel_mse, mh.rel_mse, max_ratio,
+                     100.0 * double(over) / double(i));
+      }
+    }
+  }
+}
 }  // namespace
 
 void add_cmd_bench(CLI::App& app) {
@@ -455,6 +587,22 @@ void add_cmd_bench(CLI::App& app) {
       ->check(CLI::IsMember({"structured", "greedy", "both"}))
       ->capture_default_str();
   planted->callback([pa] { run_bench_planted(*pa); });
+
+  auto* extrap = bench->add_subcommand(
+      "extrapolation",
+      "Measured BRDFs fitted on their raw samples (McCool, greedy search wiwo and halfdiff, 2 and 3 textures) "
+      "for each extrapolation_prior: training rel_mse and the largest approx / max(original) over a grid^4 set "
+      "of direction pairs");
+  auto ea = std::make_shared<BenchExtrapolationArgs>();
+  extrap->add_option("--brdf", ea->brdfs, "measured BRDFs (catalogue names or files)")->capture_default_str();
+  extrap->add_option("--texture", ea->texture, "texture resolution")->capture_default_str();
+  extrap->add_option("--restarts", ea->restarts, "random starts per term of the searches")->capture_default_str();
+  extrap->add_option("--grid", ea->grid, "grid^4 direction pairs (cell centres in cos theta and phi)")
+      ->capture_default_str();
+  extrap->add_option("--threads", ea->threads, "threads for the restarts (0 = all cores)")->capture_default_str();
+  extrap->add_option("--priors", ea->priors, "extrapolation_prior values to compare (0 = off)")
+      ->capture_default_str();
+  extrap->callback([ea] { run_bench_extrapolation(*ea); });
 }
 
 }  // namespace bf

@@ -25,6 +25,9 @@ void FitOptions::validate() const {
   if (!(smoothing >= 0.0) || !std::isfinite(smoothing))
     throw OptionError("smoothing", "smoothing: expected a finite value >= 0, found " +
                                 std::to_string(smoothing));
+  if (!(extrapolation_prior >= 0.0) || !std::isfinite(extrapolation_prior))
+    throw OptionError("extrapolation_prior", "extrapolation_prior: expected a finite value >= 0, found " +
+                                                 std::to_string(extrapolation_prior));
   if (solve_last < 1)
     throw OptionError("solve_last", "solve_last: expected >= 1, found " + std::to_string(solve_last));
 }
@@ -45,6 +48,37 @@ FitData::FitData(const SampleSet& s, double eps) {
     for (int c = 0; c < 3; ++c) g[c].push_back(transform.g(c, s.value[k][c]));
   }
   if (!(W > 0.0)) throw std::invalid_argument("fit: the valid samples' weights sum to 0");
+  // Prior points (FitOptions::extrapolation_prior): the centres of a G^4 grid
+  // of cells in (cos theta_i, phi_i, cos theta_o, phi_o) (equal solid angle),
+  // weighted wbar * exp(-4 n), n = (sample weight in the cell) / wbar; cells
+  // holding samples get a negligible weight and are dropped below 1e-12 wbar.
+  constexpr int G = kPriorGrid;
+  const double wbar = W / static_cast<double>(n);
+  const auto cell_of = [](const Vec3& v) {
+    const double ct = std::clamp(v.z() / v.norm(), 0.0, 1.0);
+    double ph = std::atan2(v.y(), v.x());
+    if (ph < 0) ph += 2 * M_PI;
+    const int a = std::min(G - 1, static_cast<int>(ct * G));
+    const int b = std::min(G - 1, static_cast<int>(ph / (2 * M_PI) * G));
+    return a * G + b;
+  };
+  std::vector<double> in_cell(size_t(G) * G * G * G, 0.0);
+  for (size_t k = 0; k < s.size(); ++k)
+    if (s.valid[k]) in_cell[size_t(cell_of(s.wi[k])) * G * G + cell_of(s.wo[k])] += s.weight_of(k);
+  std::vector<Vec3> centre;
+  for (int a = 0; a < G; ++a)
+    for (int b = 0; b < G; ++b) {
+      const double ct = (a + 0.5) / G, st = std::sqrt(1 - ct * ct), ph = 2 * M_PI * (b + 0.5) / G;
+      centre.emplace_back(st * std::cos(ph), st * std::sin(ph), ct);
+    }
+  for (size_t i = 0; i < centre.size(); ++i)
+    for (size_t o = 0; o < centre.size(); ++o) {
+      const double pw = wbar * std::exp(-4.0 * in_cell[i * centre.size() + o] / wbar);
+      if (!(pw > 1e-12 * wbar)) continue;
+      prior_wiwo.push_back(to_point(Parameterization::WiWo, centre[i], centre[o]));
+      prior_halfdiff.push_back(to_point(Parameterization::HalfDiff, centre[i], centre[o]));
+      prior_w.push_back(pw);
+    }
 }
 
 double model_log_value(double s, const FitOptions& opt) {
@@ -385,6 +419,146 @@ void assemble_dense(const FitData& d, const std::array<const double*, 3>& r,
 
 }
 
+// The bounded-extrapolation prior (FitOptions::extrapolation_prior, see
+// homomorphic_fit.h), as weighted rows sum_r w_r (b_r . y - c_r)^2 added to the
+// least-squares problem like samples:
+//  - one row per prior point of d (the function there pulled toward the joint
+//    terms' neutral sum, the weighted mean of the targets r), b_r its bilinear
+//    lookups as for a sample, w_r = rho * d.prior_w;
+//  - one row per unknown texel (b_r = e_i) with w_r = rho * wbar * exp(-q_i),
+//    q_i = (weight reaching the texel through samples' bilinear weights) / wbar,
+//    target its term's neutral value (first joint term: the mean target,
+//    halved for a reciprocal term, which is read twice; later joint terms: 0,
+//    the level the gauge gives them).
+struct Prior {
+  std::vector<int> start;    // row r: entries start[r] .. start[r + 1] - 1
+  std::vector<int> idx;
+  std::vector<double> val;
+  std::vector<double> w;     // per row
+  std::vector<std::array<double, 3>> target;  // per row
+  // Texels no sample reaches, per joint term: sum_i w_i (y_i - ybar)^2 with
+  // ybar the w-weighted mean of the same texels (a free level of the term).
+  struct Level {
+    std::vector<int> idx;
+    std::vector<double> w;
+    double sum = 0;
+    double energy(const Eigen::MatrixXd& Y, int c) const {
+      double s1 = 0, s2 = 0;
+      for (size_t a = 0; a < idx.size(); ++a) {
+        s1 += w[a] * Y(idx[a], c);
+        s2 += w[a] * Y(idx[a], c) * Y(idx[a], c);
+      }
+      return s2 - s1 * s1 / sum;
+    }
+  };
+  std::vector<Level> levels;
+  bool on() const { return !w.empty() || !levels.empty(); }
+  size_t rows() const { return w.size(); }
+  // (b_r . y) for channel column y.
+  double dot(size_t r, const Eigen::MatrixXd& Y, int c) const {
+    double v = 0;
+    for (int e = start[r]; e < start[r + 1]; ++e) v += val[e] * Y(idx[e], c);
+    return v;
+  }
+};
+
+Prior extrapolation_prior(const FitData& d, const std::array<std::vector<double>, 3>& fixed_values,
+                          const std::vector<TermLayout>& terms,
+                          const std::vector<const std::array<Lookups, 2>*>& lookups, int M,
+                          const FitOptions& opt) {
+  Prior p;
+  const size_t N = d.size();
+  const double rho = opt.extrapolation_prior;
+  if (!(rho > 0.0) || M == 0 || N == 0) return p;
+  const double wbar = d.W / static_cast<double>(N);
+  std::array<double, 3> mean_r = {0, 0, 0};
+  for (size_t k = 0; k < N; ++k)
+    for (int c = 0; c < 3; ++c) mean_r[c] += d.w[k] * (d.g[c][k] - fixed_values[c][k]);
+  for (int c = 0; c < 3; ++c) mean_r[c] /= d.W;
+  p.start.push_back(0);
+  // Prior points: their lookups, as add_layout computes a sample's (every cell
+  // a point of the domain reads lies in the projection mask; a point whose
+  // cell is not an unknown is skipped).
+  for (size_t v = 0; v < d.prior_w.size(); ++v) {
+    const size_t e0 = p.idx.size();
+    bool ok = true;
+    for (const TermLayout& t : terms) {
+      const Vec4& x = t.x == &d.x_wiwo ? d.prior_wiwo[v] : d.prior_halfdiff[v];
+      const int R = t.proj.res;
+      for (int h = 0; h < (t.reciprocal ? 2 : 1); ++h) {
+        const FastProj& fp = h == 0 ? t.proj : t.conj;
+        const double u = std::clamp(fp.M.row(0).dot(x) + fp.off, 0.0, double(R - 1));
+        const double w = std::clamp(fp.M.row(1).dot(x) + fp.off, 0.0, double(R - 1));
+        const int i = std::min(static_cast<int>(u), R - 2), j = std::min(static_cast<int>(w), R - 2);
+        const int c = j * R + i;
+        const double fa = u - i, fb = w - j;
+        const int id[4] = {t.unk[c], t.unk[c + 1], t.unk[c + R], t.unk[c + R + 1]};
+        const double bw[4] = {(1 - fa) * (1 - fb), fa * (1 - fb), (1 - fa) * fb, fa * fb};
+        for (int e = 0; e < 4; ++e) {
+          ok = ok && id[e] >= 0;
+          p.idx.push_back(id[e]);
+          p.val.push_back(bw[e]);
+        }
+      }
+    }
+    if (!ok) {
+      p.idx.resize(e0);
+      p.val.resize(e0);
+      continue;
+    }
+    p.start.push_back(static_cast<int>(p.idx.size()));
+    p.w.push_back(rho * d.prior_w[v]);
+    p.target.push_back(mean_r);
+  }
+  // Texels no sample reaches.
+  std::vector<double> reach(M, 0.0);
+  for (size_t ti = 0; ti < terms.size(); ++ti) {
+    const TermLayout& t = terms[ti];
+    const int R = t.proj.res;
+    for (int h = 0; h < (t.reciprocal ? 2 : 1); ++h) {
+      const Lookups& lk = (*lookups[ti])[h];
+      for (size_t k = 0; k < N; ++k) {
+        const int c = lk.cell[k];
+        const double a = lk.fa[k], b = lk.fb[k], w = d.w[k];
+        reach[t.unk[c]] += w * (1 - a) * (1 - b);
+        reach[t.unk[c + 1]] += w * a * (1 - b);
+        reach[t.unk[c + R]] += w * (1 - a) * b;
+        reach[t.unk[c + R + 1]] += w * a * b;
+      }
+    }
+  }
+  for (size_t ti = 0; ti < terms.size(); ++ti) {
+    const TermLayout& t = terms[ti];
+    Prior::Level lv;
+    for (int i = t.first; i < t.first + t.count; ++i) {
+      const double lw = rho * wbar * std::exp(-20.0 * reach[i] / wbar);
+      if (!(lw > 1e-12 * wbar)) continue;
+      lv.idx.push_back(i);
+      lv.w.push_back(lw);
+      lv.sum += lw;
+    }
+    if (lv.idx.size() > 1) p.levels.push_back(std::move(lv));
+  }
+  return p;
+}
+
+// Adds the prior to a dense normal matrix (lower triangle) and rhs.
+void add_prior_dense(const Prior& p, Eigen::MatrixXd& A, Eigen::MatrixXd* rhs) {
+  for (const Prior::Level& lv : p.levels)  // Lambda - lambda lambda^T / sum(lambda)
+    for (size_t a = 0; a < lv.idx.size(); ++a)
+      for (size_t b = 0; b < lv.idx.size(); ++b)
+        if (lv.idx[a] >= lv.idx[b]) A(lv.idx[a], lv.idx[b]) += (a == b ? lv.w[a] : 0.0) - lv.w[a] * lv.w[b] / lv.sum;
+  for (size_t r = 0; r < p.rows(); ++r) {
+    const double w = p.w[r];
+    for (int a = p.start[r]; a < p.start[r + 1]; ++a) {
+      for (int b = p.start[r]; b < p.start[r + 1]; ++b)
+        if (p.idx[a] >= p.idx[b]) A(p.idx[a], p.idx[b]) += w * p.val[a] * p.val[b];
+      if (rhs)
+        for (int c = 0; c < 3; ++c) (*rhs)(p.idx[a], c) += w * p.val[a] * p.target[r][c];
+    }
+  }
+}
+
 }  // namespace
 
 struct JointPrefix::Impl {
@@ -480,6 +654,7 @@ JointSolution solve_joint(const FitData& d, const std::array<std::vector<double>
   };
 
   const double mu = opt.smoothing * d.W / std::max(M, 1);
+  const Prior prior = extrapolation_prior(d, fixed_values, terms, lookups, M, opt);
   Eigen::MatrixXd Y(M, 3);  // solution, one column per channel
   double quad_rel_mse = -1;  // set by the dense path when !exact_error
   std::vector<int> idx(maxL);
@@ -515,6 +690,19 @@ JointSolution solve_joint(const FitData& d, const std::array<std::vector<double>
         for (int a = 0; a < n; ++a) trip.emplace_back(row, li[a], smu * lv[a]);
         ++row;
       });
+    for (size_t pr = 0; pr < prior.rows(); ++pr, ++row) {
+      const double sw = std::sqrt(prior.w[pr]);
+      for (int e = prior.start[pr]; e < prior.start[pr + 1]; ++e) {
+        trip.emplace_back(row, prior.idx[e], sw * prior.val[e]);
+        for (int c = 0; c < 3; ++c) rhs(prior.idx[e], c) += prior.w[pr] * prior.val[e] * prior.target[pr][c];
+      }
+    }
+    for (const Prior::Level& lv : prior.levels)  // rows sqrt(w_i) (e_i - w / sum)
+      for (size_t a = 0; a < lv.idx.size(); ++a, ++row) {
+        const double sw = std::sqrt(lv.w[a]);
+        for (size_t b = 0; b < lv.idx.size(); ++b)
+          trip.emplace_back(row, lv.idx[b], sw * ((a == b ? 1.0 : 0.0) - lv.w[b] / lv.sum));
+      }
     SpMat B(row, M);
     B.setFromTriplets(trip.begin(), trip.end());
     trip.clear();
@@ -589,6 +777,7 @@ JointSolution solve_joint(const FitData& d, const std::array<std::vector<double>
       A.block(terms[t].first, terms[t].first, terms[t].count, terms[t].count)
           .triangularView<Eigen::Lower>() += Eigen::MatrixXd::Constant(terms[t].count, terms[t].count, gamma);
     }
+    add_prior_dense(prior, A, &rhs);
     reg_diag = 1e-12 * mean_diag + std::numeric_limits<double>::min();
     A.diagonal().array() += reg_diag;
     // In place, one factorization for the 3 channels; the CPU's widest
@@ -616,6 +805,13 @@ JointSolution solve_joint(const FitData& d, const std::array<std::vector<double>
           const double sum = Y.col(c).segment(terms[t].first, terms[t].count).sum();
           reg += mean_diag / terms[t].count * sum * sum;
         }
+        // The prior adds w b b^T to the matrix and w c b to rhs:
+        // sum_r w_r ((b_r.y)^2 - 2 c_r (b_r.y)) restores the data residual.
+        for (size_t pr = 0; pr < prior.rows(); ++pr) {
+          const double by = prior.dot(pr, Y, c);
+          reg += prior.w[pr] * by * (by - 2.0 * prior.target[pr][c]);
+        }
+        for (const Prior::Level& lv : prior.levels) reg += lv.energy(Y, c);
         se += sum_wr2[c] - Y.col(c).dot(rhs.col(c)) - reg;
       }
       quad_rel_mse = std::max(0.0, se) / (3.0 * d.W);
@@ -625,7 +821,10 @@ JointSolution solve_joint(const FitData& d, const std::array<std::vector<double>
     // solve the least-squares problem by Householder QR, without normal equations.
     int lap_rows = 0;
     for (const TermLayout& t : terms) laplacian_rows(t, [&](const int*, const double*, int) { ++lap_rows; });
-    const int rows = static_cast<int>(N) + lap_rows + static_cast<int>(terms.size()) - 1;
+    int level_rows = 0;
+    for (const Prior::Level& lv : prior.levels) level_rows += static_cast<int>(lv.idx.size());
+    const int rows = static_cast<int>(N) + lap_rows + static_cast<int>(terms.size()) - 1 +
+                     static_cast<int>(prior.rows()) + level_rows;
     Eigen::MatrixXd B = Eigen::MatrixXd::Zero(rows, M);
     Eigen::MatrixXd r = Eigen::MatrixXd::Zero(rows, 3);
     for (size_t k = 0; k < N; ++k) {
@@ -647,6 +846,16 @@ JointSolution solve_joint(const FitData& d, const std::array<std::vector<double>
       for (int i = 0; i < terms[t].count; ++i) B(row, terms[t].first + i) = sg;
       ++row;
     }
+    for (size_t pr = 0; pr < prior.rows(); ++pr, ++row) {
+      const double sl = std::sqrt(prior.w[pr]);
+      for (int e = prior.start[pr]; e < prior.start[pr + 1]; ++e) B(row, prior.idx[e]) += sl * prior.val[e];
+      for (int c = 0; c < 3; ++c) r(row, c) = sl * prior.target[pr][c];
+    }
+    for (const Prior::Level& lv : prior.levels)
+      for (size_t a = 0; a < lv.idx.size(); ++a, ++row) {
+        const double sw = std::sqrt(lv.w[a]);
+        for (size_t b = 0; b < lv.idx.size(); ++b) B(row, lv.idx[b]) += sw * ((a == b ? 1.0 : 0.0) - lv.w[b] / lv.sum);
+      }
     Y = B.colPivHouseholderQr().solve(r);
   }
   if (!Y.allFinite()) throw std::runtime_error("fit: the solution is not finite");
@@ -742,6 +951,7 @@ Eigen::MatrixXd joint_normal_matrix(const FitData& d, const std::vector<TermSpec
   for (size_t t = 1; t < terms.size(); ++t)
     A.block(terms[t].first, terms[t].first, terms[t].count, terms[t].count).triangularView<Eigen::Lower>() +=
         Eigen::MatrixXd::Constant(terms[t].count, terms[t].count, mean_diag / terms[t].count);
+  add_prior_dense(extrapolation_prior(d, no_fixed, terms, lookups, M, opt), A, nullptr);
   return A.selfadjointView<Eigen::Lower>();
 }
 

@@ -25,6 +25,16 @@
 //    to 0 without changing the fitted function: the constant lands in the
 //    first joint term. Paths agree on the function, not on the split. A ridge of 1e-12 * mean diagonal guards
 //    against any remaining exact singularity (a texel nothing constrains).
+//  - Bounded extrapolation (extrapolation_prior = rho > 0, docs/design.md
+//    §3.2; default 0 = off): two gauge-blind additions. Prior points: the
+//    centres of a 6^4 grid of equal-solid-angle cells over (wi, wo), each a
+//    row like a sample with target the neutral sum c = weighted mean of the
+//    targets r and weight rho * wbar * exp(-4 n) (n = sample weight in its
+//    cell / wbar, wbar = W / N). Levels: per joint term, the texels no sample
+//    reaches (weight rho * wbar * exp(-20 q_i), q_i = sample weight reaching
+//    texel i through bilinear weights / wbar) are pulled toward their own
+//    weighted mean (a free level), so they extrapolate flat instead of along
+//    the Laplacian's linear ramps (exponentially in the BRDF).
 #pragma once
 
 #include <array>
@@ -43,6 +53,10 @@ struct FitOptions {
   double smoothing = 1e-3;   // Laplacian weight relative to the mean sample weight per texel, >= 0
   bool subtract_eps = true;  // reconstruct A exp(s) - eps A (clamped at 0) instead of A exp(s)
   int solve_last = 2;        // n: the last n terms are solved jointly, >= 1
+  // rho: weight (in mean sample weights) of the bounded-extrapolation prior
+  // (header comment, docs/design.md §3.2); 0 = off (pure Laplacian
+  // extrapolation, the rule before issue #15). Finite, >= 0.
+  double extrapolation_prior = 0.0;
   // Dense: normal matrix assembled densely, LLT. Sparse: B assembled sparse,
   // B^T W B by sparse product, CHOLMOD supernodal LLT (SimplicialLLT without CHOLMOD). Auto: dense up to
   // 1500 unknowns, sparse above (measured crossover, docs/speed.md "Inner loop"). ReferenceQR: the
@@ -72,6 +86,14 @@ class FitData {
   std::vector<double> w;                 // weight per valid sample
   double W = 0;                          // sum of w
   std::array<std::vector<double>, 3> g;  // log-space target per channel
+  // Prior points of the bounded-extrapolation prior (FitOptions::
+  // extrapolation_prior): the centres of a kPriorGrid^4 grid of equal-solid-
+  // angle cells over (wi, wo), each weighted wbar * exp(-4 n) with n the sample
+  // weight falling in its cell / wbar (wbar = W / size()); cells that hold
+  // samples (weight below 1e-12 wbar) are left out.
+  static constexpr int kPriorGrid = 6;
+  std::vector<Vec4> prior_wiwo, prior_halfdiff;
+  std::vector<double> prior_w;
   const std::vector<Vec4>& points(Parameterization p) const {
     return p == Parameterization::WiWo ? x_wiwo : x_halfdiff;
   }

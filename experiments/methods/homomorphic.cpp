@@ -17,6 +17,9 @@ std::vector<KeySpec> fit_keys(const KeySpec& texture_size) {
   return {texture_size,
           num_key("smoothing", 0.0, kInf, false, "1e-3", "Laplacian weight relative to the mean sample weight per texel"),
           num_key("eps", 0.0, 1.0, true, "1e-5", "log-transform eps of the fit (docs/design.md §2)"),
+          num_key("extrapolation_prior", 0.0, kInf, false, "0",
+                  "weight (in mean sample weights) pulling the fit toward the data's mean log value where no "
+                  "sample lies (docs/design.md §3.2); 0 = off (pure Laplacian extrapolation)"),
           bool_key("subtract_eps", "true",
                    "reconstruct A·exp(s) − eps·A (clamped at 0) instead of A·exp(s); run.json says which"),
           int_key("solve_last", 1, 64, "2", "n: the last n terms are solved jointly (thesis 3.2.2)"),
@@ -61,12 +64,14 @@ const KeySpec& refine_key(const std::string& name) {
 void read_fit_options(Reader& r, FitOptions& f, json& o) {
   f.eps = r.number(fit_key("eps"), f.eps);
   f.smoothing = r.number(fit_key("smoothing"), f.smoothing);
+  f.extrapolation_prior = r.number(fit_key("extrapolation_prior"), f.extrapolation_prior);
   f.subtract_eps = r.boolean(fit_key("subtract_eps"), f.subtract_eps);
   f.solve_last = static_cast<int>(r.integer(fit_key("solve_last"), f.solve_last));
   const std::string solver = r.choice(fit_key("solver"), "auto");
   f.solver = parse_solver(solver);
   o["eps"] = f.eps;
   o["smoothing"] = f.smoothing;
+  o["extrapolation_prior"] = f.extrapolation_prior;
   o["subtract_eps"] = f.subtract_eps;
   o["solve_last"] = f.solve_last;
   o["solver"] = solver;

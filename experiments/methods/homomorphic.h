@@ -19,7 +19,7 @@ std::vector<KeySpec> refine_keys();
 KeySpec homomorphic_texture_key();
 constexpr int kFitTextureMin = 2, kFitTextureMax = 1024;
 
-// Reads smoothing, eps, subtract_eps, solve_last, solver into f and o.
+// Reads smoothing, extrapolation_prior, eps, subtract_eps, solve_last, solver into f and o.
 void read_fit_options(Reader& r, FitOptions& f, nlohmann::json& o);
 // The refinement keys, read first (whatever refine is, so a sweep over refine
 // can carry them) and hashed only when a refinement runs.
