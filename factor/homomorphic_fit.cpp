@@ -543,7 +543,7 @@ Prior extrapolation_prior(const FitData& d, const std::array<std::vector<double>
 }
 
 // Adds the prior to a dense normal matrix (lower triangle) and rhs.
-void add_prior_dense(const Prior& p, Eigen::MatrixXd& A, Eigen::MatrixXd* rhs) {
+void add_prior_dense(const Prior& p, Eigen::Ref<Eigen::MatrixXd> A, Eigen::MatrixXd* rhs) {
   for (const Prior::Level& lv : p.levels)  // Lambda - lambda lambda^T / sum(lambda)
     for (size_t a = 0; a < lv.idx.size(); ++a)
       for (size_t b = 0; b < lv.idx.size(); ++b)
@@ -951,7 +951,12 @@ Eigen::MatrixXd joint_normal_matrix(const FitData& d, const std::vector<TermSpec
   for (size_t t = 1; t < terms.size(); ++t)
     A.block(terms[t].first, terms[t].first, terms[t].count, terms[t].count).triangularView<Eigen::Lower>() +=
         Eigen::MatrixXd::Constant(terms[t].count, terms[t].count, mean_diag / terms[t].count);
-  add_prior_dense(extrapolation_prior(d, no_fixed, terms, lookups, M, opt), A, nullptr);
+  if (opt.extrapolation_prior > 0.0) {
+    const std::array<std::vector<double>, 3> no_fixed{std::vector<double>(d.size(), 0.0),
+                                                      std::vector<double>(d.size(), 0.0),
+                                                      std::vector<double>(d.size(), 0.0)};
+    add_prior_dense(extrapolation_prior(d, no_fixed, terms, lookups, M, opt), A, nullptr);
+  }
   return A.selfadjointView<Eigen::Lower>();
 }
 
