@@ -29,8 +29,9 @@ double now_seconds() {
 }  // namespace
 
 void SearchOptions::validate() const {
-  if (strategy != "structured" && strategy != "greedy")
-    throw OptionError("strategy", "strategy: expected \"structured\" or \"greedy\", found \"" + strategy + "\"");
+  if (strategy != "structured" && strategy != "greedy" && strategy != "best")
+    throw OptionError("strategy", "strategy: expected \"structured\", \"greedy\" or \"best\", found \"" +
+                                      strategy + "\"");
   if (term_param != "either" && term_param != "fixed")
     throw OptionError("term_param", "term_param: expected \"either\" or \"fixed\", found \"" + term_param + "\"");
   if (keep < 1) throw OptionError("keep", "keep: expected >= 1, found " + std::to_string(keep));
@@ -39,16 +40,17 @@ void SearchOptions::validate() const {
     throw OptionError("joint_polish_terms", "joint_polish_terms: expected >= 0, found " + std::to_string(joint_polish_terms));
   if (polish_sweeps < 0)
     throw OptionError("polish_sweeps", "polish_sweeps: expected >= 0, found " + std::to_string(polish_sweeps));
-  if (strategy == "structured") {
+  if (strategy != "greedy") {  // structured, and best (which runs the structured search too)
+    const std::string who = "the " + strategy + " strategy";
     if (beam != 1)
-      throw OptionError("beam", "beam: the structured strategy has no beam (expected 1, found " +
+      throw OptionError("beam", "beam: " + who + " has no beam (expected 1, found " +
                                   std::to_string(beam) + "); beam is an option of strategy = \"greedy\"");
     if (backfit_sweeps != 0)
-      throw OptionError("backfit_sweeps", "backfit_sweeps: the structured strategy polishes with polish_sweeps "
+      throw OptionError("backfit_sweeps", "backfit_sweeps: " + who + " polishes with polish_sweeps "
                                   "(expected 0, found " + std::to_string(backfit_sweeps) +
                                   "); backfitting is an option of strategy = \"greedy\"");
     if (optimizer != "powell")
-      throw OptionError("optimizer", "optimizer: the structured strategy uses powell, found \"" + optimizer +
+      throw OptionError("optimizer", "optimizer: " + who + " uses powell, found \"" + optimizer +
                                   "\"; the nlopt optimizers are options of strategy = \"greedy\"");
   }
   if (terms < 1) throw OptionError("terms", "terms: expected >= 1, found " + std::to_string(terms));
@@ -72,7 +74,7 @@ void SearchOptions::validate() const {
     throw OptionError("backfit_restarts", "backfit_restarts: expected 0.." + std::to_string(kMaxRestarts) + ", found " +
                                 std::to_string(backfit_restarts));
   for (const auto& g : guesses) guess_rotation(g);  // throws for unknown names
-  if (strategy == "greedy" && restarts == 0 && guesses.empty())
+  if (strategy != "structured" && restarts == 0 && guesses.empty())
     throw OptionError("restarts", "restarts: 0 restarts and no guesses leave nothing to search from");
   if (std::find(std::begin(kOptimizers), std::end(kOptimizers), optimizer) == std::end(kOptimizers))
     throw OptionError("optimizer", "optimizer: expected powell, praxis, bobyqa, neldermead, sbplx, "
@@ -402,12 +404,42 @@ double ScheduleObjective::operator()(const Rotation4& r) const {
   }
 }
 
+namespace {
+
+// strategy = "best": the greedy and the structured search on the same data,
+// the one whose final factorization has the lower rel_mse (ties: greedy, the
+// thesis's); fits and seconds are those of both. With a stopping rule (a
+// tolerance) the greedy search alone, which is the one that stops after a term.
+SearchResult best_of_both(const FitData& data, const SearchOptions& opt) {
+  SearchOptions g = opt;
+  g.strategy = "greedy";
+  if (opt.stop_after_term) return search_factorization(data, g);
+  SearchOptions s = opt;
+  s.strategy = "structured";
+  SearchResult a = search_factorization(data, g);
+  SearchResult b = search_factorization(data, s);
+  const int evaluations = a.evaluations + b.evaluations;
+  const double seconds = a.seconds + b.seconds;
+  SearchResult out = b.rel_mse_after_term.back() < a.rel_mse_after_term.back() ? std::move(b) : std::move(a);
+  out.evaluations = evaluations;
+  out.seconds = seconds;
+  return out;
+}
+
+}  // namespace
+
 SearchResult search_factorization(const FitData& data, const SearchOptions& opt) {
   opt.validate();
-  if (opt.strategy == "structured") return structured_search(data, opt);
+  if (opt.strategy == "best") return best_of_both(data, opt);
+  if (opt.strategy == "structured") {
+    SearchResult r = structured_search(data, opt);
+    r.strategy = "structured";
+    return r;
+  }
   const double t0 = now_seconds();
   const int sres = opt.search_texture_size > 0 ? opt.search_texture_size : opt.texture_size;
   SearchResult out;
+  out.strategy = "greedy";
 
   // Term 1: every start; the beam keeps the best `beam` of them (ties by index).
   Branch root;

@@ -37,10 +37,12 @@ inline constexpr uint64_t kMaxTotalTexels = uint64_t(1) << 26;  // terms x textu
 
 struct SearchOptions {
   // "structured" (structured_search.h: seeds read off the data's Hessians,
-  // screened starts, pair moves, joint polish, per-term parameterization) or
+  // screened starts, pair moves, joint polish, per-term parameterization),
   // "greedy" (Cole's search of this file, the thesis's; reproduces the numbers
-  // of earlier versions). beam, backfitting and the nlopt optimizers are
-  // options of the greedy strategy only.
+  // of earlier versions) or "best" (both, keeping the one whose final
+  // factorization has the lower rel_mse; with stop_after_term, greedy alone).
+  // beam, backfitting and the nlopt optimizers are options of the greedy
+  // strategy only.
   std::string strategy = "structured";
   int terms = 2;                        // textures to build, >= 1
   // The parameterization of every term (greedy; structured with term_param = "fixed").
@@ -100,6 +102,7 @@ struct SearchResult {
   // and the best configuration the beam held after term k, refit jointly at
   // texture_size. Empty for the greedy search (its k-term answer is the prefix).
   std::vector<std::shared_ptr<HomomorphicFactorization>> answers;
+  std::string strategy;                    // the strategy that made it ("best": the winner's)
   double search_rel_mse = 0;               // final objective at the search resolution
   std::vector<double> beam_rel_mse;        // final error (texture_size) of each beam branch
   int best_branch = 0;                     // the winning branch (0 = the greedy one)

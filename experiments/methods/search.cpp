@@ -56,11 +56,14 @@ const std::vector<KeySpec>& search_keys() {
         other_key("tolerance", "table", "",
                   "stop after the first term that reaches the target; `terms` is then the cap (default 8); "
                   "needs `beam = 1`"),
-        choice_key("strategy", {"greedy", "structured"}, "greedy",
+        choice_key("strategy", {"best", "greedy", "structured"}, "best",
                    "`greedy`: Cole's search, term by term (the keys above). `structured` (search/structured_search.h): "
                    "starts from planes read off the data's Hessians, Cole's guesses in both parameterizations and "
                    "seeded random rotations, a beam of partial configurations, a joint polish of every term and a "
-                   "joint final refit; refuses `beam`, `backfit_*` and the nlopt optimizers. Measured in docs/search.md"),
+                   "joint final refit; refuses `beam`, `backfit_*` and the nlopt optimizers. `best`: both, keeping "
+                   "the factorization with the lower rel_mse (run.json `search_strategy` says which; with a "
+                   "tolerance the greedy search alone); refuses what `structured` refuses. Default `best`, or `greedy` when "
+                   "`beam`, `backfit_sweeps`, `backfit_restarts` or `optimizer` is given. Measured in docs/search.md"),
         choice_key("term_param", {"either", "fixed"}, "either",
                    "structured: each term reads the wiwo or the halfdiff point as the search chooses (`either`), or "
                    "every term reads `parameterization` (`fixed`)"),
@@ -171,9 +174,12 @@ class SearchKind final : public HomomorphicKind {
   void read(Reader& r, MethodVariant& m, json& o, uint64_t base_seed) const override {
     read_refine_options(r, m, o);
     SearchOptions& s = m.search;
-    // Configs default to Cole's greedy search (existing configs keep their
-    // results and run ids); strategy = "structured" selects the new search.
-    s.strategy = r.choice(key("strategy"), "greedy");
+    // Configs default to both searches, the better one kept (never worse than
+    // Cole's greedy search at any term count); "greedy" reproduces earlier results.
+    // A greedy-only key (beam, backfit_*, optimizer) without a strategy means greedy.
+    const bool greedy_keys =
+        r.has("beam") || r.has("backfit_sweeps") || r.has("backfit_restarts") || r.has("optimizer");
+    s.strategy = r.choice(key("strategy"), greedy_keys ? "greedy" : "best");
     s.term_param = r.choice(key("term_param"), s.term_param);
     s.keep = static_cast<int>(r.integer(key("keep"), s.keep));
     s.polish_sweeps = static_cast<int>(r.integer(key("polish_sweeps"), s.polish_sweeps));
@@ -205,7 +211,7 @@ class SearchKind final : public HomomorphicKind {
     s.backfit_restarts = static_cast<int>(r.integer(key("backfit_restarts"), s.backfit_restarts));
     m.seed = static_cast<uint64_t>(r.integer(key("seed"), static_cast<int64_t>(base_seed)));
     read_fit_options(r, m.fit, o);
-    if (s.strategy == "greedy" && s.restarts == 0 && s.guesses.empty() && !r.failed())
+    if (s.strategy != "structured" && s.restarts == 0 && s.guesses.empty() && !r.failed())
       r.fail("restarts", "restarts = 0 and no guesses leave nothing to search from (give restarts >= 1 or guesses)");
     s.terms = m.terms;
     s.param = m.param;
@@ -263,6 +269,7 @@ class SearchKind final : public HomomorphicKind {
     run.errors_after_term = sr.rel_mse_after_term;
     MethodOutcome out = finish_homomorphic(c, std::move(run), std::move(chosen), sr.evaluations);
     out.record["terms"] = term_records(sr);
+    out.record["search_strategy"] = sr.strategy;
     // The structured search's k-term answers (errors_after_term[k-1] is the
     // error of answers[k-1], which need not be a prefix of the row's factorization).
     if (!sr.answers.empty()) {

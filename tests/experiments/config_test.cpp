@@ -357,8 +357,13 @@ TEST_CASE("config: the CLI prints one line per problem and exits 2") {
 }
 
 TEST_CASE("config: non-greedy search keys (beam, backfit) are read, validated, and keep greedy run ids") {
-  const std::string greedy = std::string(kBase) + "[[method]]\nkind = \"search\"\nrestarts = 3\n";
+  const std::string greedy = std::string(kBase) + "[[method]]\nkind = \"search\"\nstrategy = \"greedy\"\nrestarts = 3\n";
   const Plan g = plan_of(greedy);
+  // Without a strategy, a greedy-only key selects the greedy search (the default is "best").
+  CHECK(plan_of(std::string(kBase) + "[[method]]\nkind = \"search\"\nrestarts = 3\n").methods[0].search.strategy ==
+        "best");
+  CHECK(plan_of(std::string(kBase) + "[[method]]\nkind = \"search\"\nbeam = 1\n").methods[0].search.strategy ==
+        "greedy");
   const Plan g1 = plan_of(greedy + "beam = 1\nbackfit_sweeps = 0\n");
   CHECK(g.runs[0].run_id == g1.runs[0].run_id);  // defaults do not change the id (cache kept)
   const Plan p = plan_of(greedy + "beam = 2\nbackfit_sweeps = [0, 3]\nbackfit_restarts = 1\n");

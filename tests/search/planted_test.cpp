@@ -142,6 +142,23 @@ TEST_CASE("structured search: a planted two-plane BRDF ends near the floor, the 
                 << " fits), greedy " << rg.rel_mse_after_term.back() << " (" << rg.evaluations << " fits)");
   CHECK(r.rel_mse_after_term.back() <= 1.5 * fl);
   CHECK(rg.rel_mse_after_term.back() > 1.5 * fl);  // the trap this search exists for
+  CHECK(r.strategy == "structured");
+  CHECK(rg.strategy == "greedy");
+  // strategy = "best" runs both and keeps the structured answer here, whole.
+  SearchOptions both = structured(2, 8);
+  both.strategy = "best";
+  const SearchResult rb = search_factorization(d, both);
+  CHECK(rb.strategy == "structured");
+  CHECK(rb.rel_mse_after_term == r.rel_mse_after_term);
+  CHECK(rb.evaluations == r.evaluations + rg.evaluations);
+  CHECK(rb.factorization->eval(Vec3(0.3, 0.1, 0.95).normalized(), Vec3(-0.2, 0.4, 0.89).normalized())
+            .isApprox(r.factorization->eval(Vec3(0.3, 0.1, 0.95).normalized(), Vec3(-0.2, 0.4, 0.89).normalized())));
+  // With a stopping rule (a tolerance) it is the greedy search alone.
+  both.stop_after_term = [](const HomomorphicFactorization&) { return false; };
+  g.stop_after_term = both.stop_after_term;
+  const SearchResult rt = search_factorization(d, both);
+  CHECK(rt.strategy == "greedy");
+  CHECK(rt.rel_mse_after_term == search_factorization(d, g).rel_mse_after_term);
 }
 
 TEST_CASE("structured search: deterministic for a seed, whatever the thread count") {
