@@ -174,4 +174,8 @@ std::optional<Tolerance> read_tolerance(Reader& r, nlohmann::json& o);
 // Keys of the tolerance table.
 const std::vector<std::string>& tolerance_keys();
 
+// Reads the [scene] table (nullptr: the default scene), problems to ctx
+// (experiments/scene_config.cpp).
+SceneSettings read_scene(const toml::table* t, Ctx& ctx);
+
 }  // namespace bf

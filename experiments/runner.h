@@ -18,6 +18,7 @@
 
 #include "experiments/config.h"
 #include "experiments/outputs.h"
+#include "experiments/run_folder.h"
 
 namespace bf {
 
@@ -49,13 +50,6 @@ struct RunSummary {
   std::vector<std::string> run_ids;  // this shard's runs, plan order
   OutputFiles files;       // empty for a dry run
 };
-
-// What each run.json records of the build that made it (key "build"):
-// brdf_factor version, and git_commit / git_dirty of the source tree when it
-// is a git checkout (software_versions()).
-nlohmann::json build_identity(const nlohmann::json& versions);
-// A run record's build.git_commit; "" when it has none (older runs, no git).
-std::string cached_run_commit(const nlohmann::json& record);
 
 // Prints the "results: ..." and "report: ..." lines of a written folder.
 void print_output_paths(std::ostream& out, const OutputFiles& f);
