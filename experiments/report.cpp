@@ -124,29 +124,11 @@ std::vector<std::string> html_links(const std::string& html) {
   return out;
 }
 
-void write_report_html(const ExperimentOutput& e, const OutputFiles& f, const std::string& path) {
-  const std::string dir = fs::path(path).parent_path().string();
-  const std::string name = e.experiment.value("name", "experiment");
-  std::ostringstream h;
-  h << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\n<title>" << esc(name)
-    << " - brdf-factor</title>\n<style>" << kStyle << "</style></head><body>\n";
-  h << "<h1>Experiment " << esc(name) << "</h1>\n";
-  if (!e.experiment.value("description", "").empty())
-    h << "<p>" << esc(e.experiment.value("description", "")) << "</p>\n";
-  size_t failed = 0;
-  for (const auto& r : e.runs) failed += r.status != "ok";
-  h << "<p>" << e.runs.size() << " runs";
-  if (e.shards > 1) h << " (shard " << e.shard << "/" << e.shards << " of " << e.plan.size() << ")";
-  if (!e.merged_from.empty()) h << " (merged from " << e.merged_from.size() << " shard folders)";
-  if (failed) h << ", <b>" << failed << " failed</b>";
-  h << ". Config <code>" << esc(e.config_path) << "</code>";
-  for (const auto& d : e.defines) h << " <code>-D " << esc(d) << "</code>";
-  h << ".</p>\n<p class=\"files\">";
-  for (const char* file : {"results.csv", "results.md", "manifest.json", "config.toml"})
-    if (exists_in(dir, file)) h << "<a href=\"" << url(file) << "\">" << file << "</a>";
-  h << "</p>\n";
+namespace {
 
-  // Results table.
+// The results table: key columns first, best values per BRDF marked,
+// failed and flagged rows shaded.
+void results_table(const ExperimentOutput& e, std::ostringstream& h) {
   h << "<h2>Results</h2>\n<p class=\"note\">Key columns first. <span class=\"best\">Green bold</span>: "
        "the best (lowest) value of that column among the runs of the same BRDF. Orange rows are flagged "
        "(validation error far above the training error, or values far above the BRDF's peak): the reason "
@@ -177,6 +159,34 @@ void write_report_html(const ExperimentOutput& e, const OutputFiles& f, const st
     h << "</tr>\n";
   }
   h << "</table></div>\n";
+
+}
+
+}  // namespace
+
+void write_report_html(const ExperimentOutput& e, const OutputFiles& f, const std::string& path) {
+  const std::string dir = fs::path(path).parent_path().string();
+  const std::string name = e.experiment.value("name", "experiment");
+  std::ostringstream h;
+  h << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\n<title>" << esc(name)
+    << " - brdf-factor</title>\n<style>" << kStyle << "</style></head><body>\n";
+  h << "<h1>Experiment " << esc(name) << "</h1>\n";
+  if (!e.experiment.value("description", "").empty())
+    h << "<p>" << esc(e.experiment.value("description", "")) << "</p>\n";
+  size_t failed = 0;
+  for (const auto& r : e.runs) failed += r.status != "ok";
+  h << "<p>" << e.runs.size() << " runs";
+  if (e.shards > 1) h << " (shard " << e.shard << "/" << e.shards << " of " << e.plan.size() << ")";
+  if (!e.merged_from.empty()) h << " (merged from " << e.merged_from.size() << " shard folders)";
+  if (failed) h << ", <b>" << failed << " failed</b>";
+  h << ". Config <code>" << esc(e.config_path) << "</code>";
+  for (const auto& d : e.defines) h << " <code>-D " << esc(d) << "</code>";
+  h << ".</p>\n<p class=\"files\">";
+  for (const char* file : {"results.csv", "results.md", "manifest.json", "config.toml"})
+    if (exists_in(dir, file)) h << "<a href=\"" << url(file) << "\">" << file << "</a>";
+  h << "</p>\n";
+
+  results_table(e, h);
 
   // Plots.
   h << "<h2>Plots</h2>\n";
