@@ -36,6 +36,63 @@ std::shared_ptr<PyFactorization> wrap(FactorizationPtr f) {
   return p;
 }
 
+namespace {
+
+// The module functions score() and load().
+void bind_score_and_load(py::module_& m) {
+  m.def(
+      "score",
+      [](const PyBrdf& approx, const SampleSet& s, double eps) {
+        py::gil_scoped_release release;
+        const Metrics mt = evaluate_metrics(*approx.brdf, s, LogTransform::of(s, eps));
+        py::gil_scoped_acquire gil;
+        return metrics_dict(mt);
+      },
+      py::arg("approx"), py::arg("samples"), py::arg("metric_eps") = 1e-5,
+      "Metrics (docs/design.md §4) of any BRDF (a factorization, a model, a reloaded export) on a sample set.");
+  m.def(
+      "load",
+      [](const std::string& path) -> py::object {
+        std::string format, method;
+        {
+          std::ifstream in(path);
+          if (!in) throw std::invalid_argument(path + ": cannot open");
+          try {
+            const nlohmann::json j = nlohmann::json::parse(in);
+            format = j.is_object() ? j.value("format", "") : "";
+            method = j.is_object() && j.contains("method") && j["method"].is_string() ? j["method"].get<std::string>() : "";
+          } catch (const nlohmann::json::exception& e) {
+            throw std::invalid_argument(path + ": not a JSON file (" + e.what() + ")");
+          }
+        }
+        if (format == kModelFitFormat) {
+          auto b = std::make_shared<PyBrdf>();
+          b->brdf = load_model_fit(path);
+          return py::cast(b);
+        }
+        if (format == kFactorExportFormat && is_baseline_method(method)) {  // svd, sh-k, sh-r
+          std::shared_ptr<Factorization> b;
+          {
+            py::gil_scoped_release release;
+            b = load_baseline_export(path);
+          }
+          return py::cast(wrap(b));
+        }
+        std::shared_ptr<const HomomorphicFactorization> h;
+        {
+          py::gil_scoped_release release;
+          h = load_factorization(path);
+        }
+        return py::cast(wrap(h));
+      },
+      py::arg("path"),
+      R"doc(Reads an export back: a factorization sidecar (STEM.json of mccool, fit,
+search, svd, sh-k, sh-r) as a Factorization (metrics None), a model-fit JSON
+as a Brdf.)doc");
+}
+
+}  // namespace
+
 void bind_factorization(py::module_& m) {
   py::class_<PyFactorization, PyBrdf, std::shared_ptr<PyFactorization>>(m, "Factorization", R"doc(
 What a method returns: an approximation that evaluates like any Brdf
@@ -135,55 +192,7 @@ load(sidecar) reads it back (bit-identical evaluation).)doc")
         return r + ">";
       });
 
-  m.def(
-      "score",
-      [](const PyBrdf& approx, const SampleSet& s, double eps) {
-        py::gil_scoped_release release;
-        const Metrics mt = evaluate_metrics(*approx.brdf, s, LogTransform::of(s, eps));
-        py::gil_scoped_acquire gil;
-        return metrics_dict(mt);
-      },
-      py::arg("approx"), py::arg("samples"), py::arg("metric_eps") = 1e-5,
-      "Metrics (docs/design.md §4) of any BRDF (a factorization, a model, a reloaded export) on a sample set.");
-  m.def(
-      "load",
-      [](const std::string& path) -> py::object {
-        std::string format, method;
-        {
-          std::ifstream in(path);
-          if (!in) throw std::invalid_argument(path + ": cannot open");
-          try {
-            const nlohmann::json j = nlohmann::json::parse(in);
-            format = j.is_object() ? j.value("format", "") : "";
-            method = j.is_object() && j.contains("method") && j["method"].is_string() ? j["method"].get<std::string>() : "";
-          } catch (const nlohmann::json::exception& e) {
-            throw std::invalid_argument(path + ": not a JSON file (" + e.what() + ")");
-          }
-        }
-        if (format == kModelFitFormat) {
-          auto b = std::make_shared<PyBrdf>();
-          b->brdf = load_model_fit(path);
-          return py::cast(b);
-        }
-        if (format == kFactorExportFormat && is_baseline_method(method)) {  // svd, sh-k, sh-r
-          std::shared_ptr<Factorization> b;
-          {
-            py::gil_scoped_release release;
-            b = load_baseline_export(path);
-          }
-          return py::cast(wrap(b));
-        }
-        std::shared_ptr<const HomomorphicFactorization> h;
-        {
-          py::gil_scoped_release release;
-          h = load_factorization(path);
-        }
-        return py::cast(wrap(h));
-      },
-      py::arg("path"),
-      R"doc(Reads an export back: a factorization sidecar (STEM.json of mccool, fit,
-search, svd, sh-k, sh-r) as a Factorization (metrics None), a model-fit JSON
-as a Brdf.)doc");
+  bind_score_and_load(m);
 }
 
 }  // namespace bf::py_module
