@@ -106,6 +106,22 @@ class Structured {
   // Jacobi sweeps over terms [from, J): each re-searched with the others held.
   // The objective is the schedule with n terms solved jointly.
   void polish(std::vector<Term>& ts, double& value, size_t from, int sweeps, int n, TermRecord* rec);
+  // A k-term answer: its terms, their refit at texture_size and its error.
+  struct Answer {
+    std::vector<Term> ts;
+    std::shared_ptr<HomomorphicFactorization> f;
+    double error = kInf;
+  };
+  // The joint refit at texture_size: every term solved together (the
+  // schedule's solution is one point of that problem, so its least-squares
+  // error is never higher); errors after each term to *errors.
+  std::shared_ptr<HomomorphicFactorization> refit(const std::vector<Term>& ts, std::vector<double>* errors) const;
+  // refit() as an Answer (f null and error infinite when the solve fails).
+  Answer answer_of(const std::vector<Term>& ts) const;
+  // The k-term answers of out (k = 1..J) from the final configuration ts and
+  // each stage's best; returns the J-term answer's terms.
+  std::vector<Term> fill_answers(const std::vector<Term>& ts, const std::vector<Answer>& stage_best,
+                                 SearchResult& out);
 
   const FitData& d_;
   const SearchOptions& opt_;
@@ -405,38 +421,69 @@ void Structured::polish(std::vector<Term>& ts, double& value, size_t from, int s
   rec->seconds += now_seconds() - t0;
 }
 
+std::shared_ptr<HomomorphicFactorization> Structured::refit(const std::vector<Term>& ts,
+                                                            std::vector<double>* errors) const {
+  errors->clear();  // fit_homomorphic appends
+  FitOptions fo = opt_.fit;
+  if (opt_.final_joint) fo.solve_last = std::max(fo.solve_last, static_cast<int>(ts.size()));
+  return fit_homomorphic(d_, specs(ts, opt_.texture_size), fo, "search", errors);
+}
+
+Structured::Answer Structured::answer_of(const std::vector<Term>& ts) const {
+  Answer a;
+  a.ts = ts;
+  std::vector<double> errors;
+  try {
+    a.f = refit(ts, &errors);
+    a.error = errors.back();
+  } catch (const std::runtime_error&) {
+    a.f = nullptr;
+  }
+  return a;
+}
+
+std::vector<Term> Structured::fill_answers(const std::vector<Term>& ts, const std::vector<Answer>& stage_best,
+                                           SearchResult& out) {
+  const int J = static_cast<int>(ts.size());
+  // The k-term answers. k = J: the final (polished) configuration or stage J's
+  // best, whichever fits better at texture_size. k < J: that answer's k-term
+  // prefix, refit jointly, or stage k's best configuration, whichever fits
+  // better. The joint refit's step k solves the first k terms together, so
+  // errors[k-1] is the prefix's error.
+  std::vector<double> errors;
+  std::shared_ptr<HomomorphicFactorization> final_f = refit(ts, &errors);
+  ++evaluations_;
+  std::vector<Term> answer_ts = ts;
+  if (stage_best[J - 1].error < errors.back()) {
+    answer_ts = stage_best[J - 1].ts;
+    final_f = refit(answer_ts, &errors);
+    ++evaluations_;
+  }
+  out.answers.resize(J);
+  out.rel_mse_after_term.resize(J);
+  out.answers[J - 1] = final_f;
+  out.rel_mse_after_term[J - 1] = errors[J - 1];
+  for (int k = J - 1; k >= 1; --k) {
+    const Answer& sb = stage_best[k - 1];
+    if (sb.error < errors[k - 1]) {
+      out.answers[k - 1] = sb.f;
+      out.rel_mse_after_term[k - 1] = sb.error;
+    } else {
+      const Answer a = answer_of(std::vector<Term>(answer_ts.begin(), answer_ts.begin() + k));
+      ++evaluations_;
+      out.answers[k - 1] = a.f;
+      out.rel_mse_after_term[k - 1] = a.error;
+    }
+  }
+  return answer_ts;
+}
+
 SearchResult Structured::run() {
   const double t0 = now_seconds();
   SearchResult out;
   std::vector<Config> beam(1);
   beam[0].value = kInf;
   std::vector<TermRecord> records;
-  // A k-term answer: its terms, their refit at texture_size and its error.
-  struct Answer {
-    std::vector<Term> ts;
-    std::shared_ptr<HomomorphicFactorization> f;
-    double error = kInf;
-  };
-  const auto refit = [&](const std::vector<Term>& ts, std::vector<double>* errors) {
-    errors->clear();  // fit_homomorphic appends
-    FitOptions fo = opt_.fit;
-    // The joint refit: every term solved together (the schedule's solution is
-    // one point of that problem, so its least-squares error is never higher).
-    if (opt_.final_joint) fo.solve_last = std::max(fo.solve_last, static_cast<int>(ts.size()));
-    return fit_homomorphic(d_, specs(ts, opt_.texture_size), fo, "search", errors);
-  };
-  const auto answer_of = [&](const std::vector<Term>& ts) {
-    Answer a;
-    a.ts = ts;
-    std::vector<double> errors;
-    try {
-      a.f = refit(ts, &errors);
-      a.error = errors.back();
-    } catch (const std::runtime_error&) {
-      a.f = nullptr;
-    }
-    return a;
-  };
   // The best k-term configuration of stage k: every configuration of the beam
   // refit at texture_size (in parallel), the lowest error kept. The beam's order
   // is the search objective's (search resolution, schedule); its best need not
@@ -496,36 +543,7 @@ SearchResult Structured::run() {
     const size_t from = n >= J ? 0 : static_cast<size_t>(J - n);
     polish(ts, value, from, opt_.polish_sweeps, n, &records.back());
   }
-  // The k-term answers. k = J: the final (polished) configuration or stage J's
-  // best, whichever fits better at texture_size. k < J: that answer's k-term
-  // prefix, refit jointly, or stage k's best configuration, whichever fits
-  // better. The joint refit's step k solves the first k terms together, so
-  // errors[k-1] is the prefix's error.
-  std::vector<double> errors;
-  std::shared_ptr<HomomorphicFactorization> final_f = refit(ts, &errors);
-  ++evaluations_;
-  std::vector<Term> answer_ts = ts;
-  if (stage_best[J - 1].error < errors.back()) {
-    answer_ts = stage_best[J - 1].ts;
-    final_f = refit(answer_ts, &errors);
-    ++evaluations_;
-  }
-  out.answers.resize(J);
-  out.rel_mse_after_term.resize(J);
-  out.answers[J - 1] = final_f;
-  out.rel_mse_after_term[J - 1] = errors[J - 1];
-  for (int k = J - 1; k >= 1; --k) {
-    const Answer& sb = stage_best[k - 1];
-    if (sb.error < errors[k - 1]) {
-      out.answers[k - 1] = sb.f;
-      out.rel_mse_after_term[k - 1] = sb.error;
-    } else {
-      const Answer a = answer_of(std::vector<Term>(answer_ts.begin(), answer_ts.begin() + k));
-      ++evaluations_;
-      out.answers[k - 1] = a.f;
-      out.rel_mse_after_term[k - 1] = a.error;
-    }
-  }
+  const std::vector<Term> answer_ts = fill_answers(ts, stage_best, out);
   for (size_t i = 0; i < answer_ts.size(); ++i) records[i].rotation = answer_ts[i].R.packed();
   records.back().search_rel_mse = value;
   out.factorization = out.answers.back();
