@@ -294,7 +294,9 @@ ExportedFiles write_factorization(const HomomorphicFactorization& f, const std::
   j["format_version"] = kFactorExportFormatVersion;
   j["glsl"] = stem + ".glsl";
   j["combine"] =
-      "per RGB channel: f = A * exp(g) " + std::string(f.subtract_eps() ? "- eps * A" : "") +
+      "per RGB channel: f = A * exp(" +
+      std::string(f.log_range() ? "clamp(g, log_range[c][0], log_range[c][1])" : "g") + ") " +
+      std::string(f.subtract_eps() ? "- eps * A" : "") +
       ", clamped at 0, where g = sum over terms of the bilinear lookup of the term's texture at "
       "s(pi(x)), plus a second lookup of the same texture at s(pi*(x)) (the conjugate "
       "projection) for reciprocal terms; x = the point of (wi, wo) in the term's "
@@ -437,6 +439,21 @@ std::shared_ptr<HomomorphicFactorization> load_factorization(const std::string& 
                               "a number in (0, 1]");
   if (!(eps > 0.0 && eps <= 1.0)) s.fail("eps", "a number in (0, 1]", j["eps"]);
   const bool subtract_eps = s.boolean(j, "", "subtract_eps");
+  // Optional (absent in exports before the log-range clamp: no clamp).
+  std::optional<LogRange> log_range;
+  if (j.contains("log_range")) {
+    const std::string expected = "an array of 3 [lo, hi] pairs of finite numbers, lo <= hi";
+    const json& r = s.array(j["log_range"], "log_range", 3, "[lo, hi] pairs");
+    log_range.emplace();
+    for (int c = 0; c < 3; ++c) {
+      const std::string field = "log_range[" + std::to_string(c) + "]";
+      const json& p = s.array(r[c], field, 2, "finite numbers (lo, hi)");
+      const double lo = s.number(p[0], field + "[0]", "a finite number");
+      const double hi = s.number(p[1], field + "[1]", "a finite number");
+      if (!(lo <= hi)) s.fail(field, "lo <= hi", r[c]);
+      (*log_range)[c] = {lo, hi};
+    }
+  }
 
   const json& tjs = s.member(j, "", "terms", "an array of terms");
   if (!tjs.is_array()) s.fail("terms", "an array of terms", tjs);
@@ -466,7 +483,8 @@ std::shared_ptr<HomomorphicFactorization> load_factorization(const std::string& 
     FactorTerm t = read_term(s, tj, where, folder);
     terms.push_back(std::move(t));
   }
-  return std::make_shared<HomomorphicFactorization>(std::move(terms), A, eps, subtract_eps, method);
+  return std::make_shared<HomomorphicFactorization>(std::move(terms), A, eps, subtract_eps, method,
+                                                    log_range);
 }
 
 namespace {

@@ -95,8 +95,10 @@ std::string generate_glsl(const HomomorphicFactorization& f,
     << "// BRDF_FACTOR_EXACT_BILINEAR before this code to filter by hand with texelFetch\n"
     << "// (float weights; any filter mode then works).\n"
     << "//\n"
-    << "// f = A * exp(sum over terms of t(pi(x)) [+ t(pi*(x)) for reciprocal terms])"
-    << (f.subtract_eps() ? " - eps * A" : "") << ", clamped at 0.\n"
+    << "// f = A * exp(" << (f.log_range() ? "clamp(g, lo, hi)" : "g")
+    << "), g = sum over terms of t(pi(x)) [+ t(pi*(x)) for reciprocal terms]"
+    << (f.subtract_eps() ? ", minus eps * A" : "") << ", clamped at 0.\n"
+    << (f.log_range() ? "// [lo, hi]: the log range of the fit's training targets, per channel.\n" : "")
     << "// eps * A is " << (f.subtract_eps() ? "" : "NOT ") << "subtracted (eps = "
     << lit(f.eps(), "eps") << ").\n\n";
   o << glsl_target_prelude() << "\n";
@@ -134,6 +136,11 @@ std::string generate_glsl(const HomomorphicFactorization& f,
     };
     emit(t.proj, "");
     if (t.reciprocal) emit(t.proj.conjugate(), " (conjugate)");
+  }
+  if (f.log_range()) {
+    const LogRange& r = *f.log_range();
+    o << "  g = clamp(g, " << vec3_lit(Rgb(r[0][0], r[1][0], r[2][0]), "log_range lo") << ", "
+      << vec3_lit(Rgb(r[0][1], r[1][1], r[2][1]), "log_range hi") << ");\n";
   }
   o << "  const vec3 A = " << vec3_lit(f.A(), "A") << ";\n";
   o << "  vec3 f = A * exp(g)";

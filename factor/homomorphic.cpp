@@ -1,6 +1,7 @@
 // HomomorphicFactorization evaluation and description (see homomorphic.h).
 #include "factor/homomorphic.h"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
@@ -22,9 +23,18 @@ double FactorTerm::lookup(int c, const Eigen::Vector2d& s) const {
 
 HomomorphicFactorization::HomomorphicFactorization(std::vector<FactorTerm> terms, Rgb A,
                                                    double eps, bool subtract_eps,
-                                                   std::string method)
+                                                   std::string method,
+                                                   std::optional<LogRange> log_range)
     : terms_(std::move(terms)), A_(A), eps_(eps), subtract_eps_(subtract_eps),
-      method_(std::move(method)) {
+      method_(std::move(method)), log_range_(log_range) {
+  if (log_range_)
+    for (int c = 0; c < 3; ++c) {
+      const auto& r = (*log_range_)[c];
+      if (!std::isfinite(r[0]) || !std::isfinite(r[1]) || !(r[0] <= r[1]))
+        throw std::invalid_argument("factorization: log_range[" + std::to_string(c) +
+                                    "] must be finite with lo <= hi, found [" +
+                                    std::to_string(r[0]) + ", " + std::to_string(r[1]) + "]");
+    }
   for (const FactorTerm& t : terms_) {
     const size_t n = size_t(t.proj.res) * t.proj.res;
     for (int c = 0; c < 3; ++c)
@@ -57,9 +67,15 @@ Rgb HomomorphicFactorization::eval_log(const Vec3& wi, const Vec3& wo) const {
   return s;
 }
 
+Rgb HomomorphicFactorization::clamp_log(Rgb s) const {
+  if (log_range_)
+    for (int c = 0; c < 3; ++c) s[c] = std::clamp(s[c], (*log_range_)[c][0], (*log_range_)[c][1]);
+  return s;
+}
+
 Rgb HomomorphicFactorization::eval(const Vec3& wi, const Vec3& wo) const {
   if (wi.z() <= 0.0 || wo.z() <= 0.0) return Rgb::Zero();
-  const Rgb s = eval_log(wi, wo);
+  const Rgb s = clamp_log(eval_log(wi, wo));
   Rgb f = A_ * s.exp();
   if (subtract_eps_) f -= eps_ * A_;
   // exp overflow cannot produce NaN here; clamp to the representable, non-negative range.
@@ -73,7 +89,7 @@ bool HomomorphicFactorization::reciprocal() const {
 }
 
 size_t HomomorphicFactorization::storage_floats() const {
-  size_t n = 4;
+  size_t n = log_range_ ? 10 : 4;
   for (const FactorTerm& t : terms_) n += 3 * t.mask_count();
   return n;
 }
@@ -94,6 +110,13 @@ nlohmann::json HomomorphicFactorization::describe() const {
   j["A"] = {A_[0], A_[1], A_[2]};
   j["eps"] = eps_;
   j["subtract_eps"] = subtract_eps_;
+  if (log_range_) {
+    j["log_range"] = {{(*log_range_)[0][0], (*log_range_)[0][1]},
+                      {(*log_range_)[1][0], (*log_range_)[1][1]},
+                      {(*log_range_)[2][0], (*log_range_)[2][1]}};
+    j["form"] = j["form"].get<std::string>() +
+                "; the sum is clamped to log_range[c] = [lo, hi] before exp";
+  }
   j["storage_floats"] = storage_floats();
   nlohmann::json terms = nlohmann::json::array();
   for (const FactorTerm& t : terms_) {

@@ -48,6 +48,10 @@ FitData::FitData(const SampleSet& s, double eps) {
     for (int c = 0; c < 3; ++c) g[c].push_back(transform.g(c, s.value[k][c]));
   }
   if (!(W > 0.0)) throw std::invalid_argument("fit: the valid samples' weights sum to 0");
+  for (int c = 0; c < 3; ++c) {
+    const auto [lo, hi] = std::minmax_element(g[c].begin(), g[c].end());
+    log_range[c] = {*lo, *hi};
+  }
   // Prior points (FitOptions::extrapolation_prior): the centres of a G^4 grid
   // of cells in (cos theta_i, phi_i, cos theta_o, phi_o) (equal solid angle),
   // weighted wbar * exp(-4 n), n = (sample weight in the cell) / wbar; cells
@@ -872,7 +876,8 @@ JointSolution solve_joint(const FitData& d, const std::array<std::vector<double>
       for (int c = 0; c < 3; ++c) {
         double s = fixed_values[c][k];
         for (int a = 0; a < L; ++a) s += val[a] * Y(idx[a], c);
-        const double e = (exact_error ? model_log_value(s, opt) : s) - d.g[c][k];
+        const double e =
+            (exact_error ? model_log_value(d.clamp_log(c, s, opt), opt) : s) - d.g[c][k];
         se += d.w[k] * e * e;
       }
     }
@@ -913,8 +918,9 @@ std::shared_ptr<HomomorphicFactorization> fit_homomorphic(const FitData& d,
     done.insert(done.end(), sol.terms.begin(), sol.terms.end());
     if (errors) errors->push_back(sol.rel_mse);
   }
-  return std::make_shared<HomomorphicFactorization>(done, d.transform.A, opt.eps,
-                                                    opt.subtract_eps, method);
+  return std::make_shared<HomomorphicFactorization>(
+      done, d.transform.A, opt.eps, opt.subtract_eps, method,
+      opt.clamp_log_range ? std::optional<LogRange>(d.log_range) : std::nullopt);
 }
 
 std::vector<TermSpec> mccool_terms(int res) {

@@ -37,6 +37,7 @@
 //    the Laplacian's linear ramps (exponentially in the BRDF).
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <memory>
 #include <optional>
@@ -57,6 +58,12 @@ struct FitOptions {
   // (header comment, docs/design.md §3.2); 0 = off (pure Laplacian
   // extrapolation, the rule before issue #15). Finite, >= 0.
   double extrapolation_prior = 0.0;
+  // Log-range clamp (docs/design.md §3.2): the factorization clamps its summed
+  // log value s_c to [min g_c, max g_c] over the valid training samples
+  // (FitData::log_range) before exp. Every training target lies in that
+  // interval, so the clamp never increases a training sample's error, and
+  // f <= A exp(max g) ~ the largest training value everywhere. Default on.
+  bool clamp_log_range = true;
   // Dense: normal matrix assembled densely, LLT. Sparse: B assembled sparse,
   // B^T W B by sparse product, CHOLMOD supernodal LLT (SimplicialLLT without CHOLMOD). Auto: dense up to
   // 1500 unknowns, sparse above (measured crossover, docs/speed.md "Inner loop"). ReferenceQR: the
@@ -86,6 +93,12 @@ class FitData {
   std::vector<double> w;                 // weight per valid sample
   double W = 0;                          // sum of w
   std::array<std::vector<double>, 3> g;  // log-space target per channel
+  // Per channel [min g_c, max g_c] over the valid samples (the log-range clamp).
+  LogRange log_range{};
+  // clamp(s, log_range[c]) if opt.clamp_log_range, else s.
+  double clamp_log(int c, double s, const FitOptions& opt) const {
+    return opt.clamp_log_range ? std::clamp(s, log_range[c][0], log_range[c][1]) : s;
+  }
   // Prior points of the bounded-extrapolation prior (FitOptions::
   // extrapolation_prior): the centres of a kPriorGrid^4 grid of equal-solid-
   // angle cells over (wi, wo), each weighted wbar * exp(-4 n) with n the sample

@@ -325,7 +325,7 @@ std::shared_ptr<HomomorphicFactorization> refine(const HomomorphicFactorization&
 
   auto out = std::make_shared<HomomorphicFactorization>(
       std::move(terms), start.A(), start.eps(), start.subtract_eps(),
-      start.method() + "+refine-" + opt.objective);
+      start.method() + "+refine-" + opt.objective, start.log_range());
   if (report) {
     report->objective = opt.objective;
     report->linear_solver = solver_name;

@@ -20,6 +20,9 @@ std::vector<KeySpec> fit_keys(const KeySpec& texture_size) {
           num_key("extrapolation_prior", 0.0, kInf, false, "0",
                   "weight (in mean sample weights) pulling the fit toward the data's mean log value where no "
                   "sample lies (docs/design.md §3.2); 0 = off (pure Laplacian extrapolation)"),
+          bool_key("clamp_log_range", "true",
+                   "clamp the summed log value to the training targets' log range before exp (docs/design.md "
+                   "§3.2): bounded extrapolation, never a worse training error; false = unclamped"),
           bool_key("subtract_eps", "true",
                    "reconstruct A·exp(s) − eps·A (clamped at 0) instead of A·exp(s); run.json says which"),
           int_key("solve_last", 1, 64, "2", "n: the last n terms are solved jointly (thesis 3.2.2)"),
@@ -66,6 +69,7 @@ void read_fit_options(Reader& r, FitOptions& f, json& o) {
   f.smoothing = r.number(fit_key("smoothing"), f.smoothing);
   f.extrapolation_prior = r.number(fit_key("extrapolation_prior"), f.extrapolation_prior);
   f.subtract_eps = r.boolean(fit_key("subtract_eps"), f.subtract_eps);
+  f.clamp_log_range = r.boolean(fit_key("clamp_log_range"), f.clamp_log_range);
   f.solve_last = static_cast<int>(r.integer(fit_key("solve_last"), f.solve_last));
   const std::string solver = r.choice(fit_key("solver"), "auto");
   f.solver = parse_solver(solver);
@@ -73,6 +77,8 @@ void read_fit_options(Reader& r, FitOptions& f, json& o) {
   o["smoothing"] = f.smoothing;
   o["extrapolation_prior"] = f.extrapolation_prior;
   o["subtract_eps"] = f.subtract_eps;
+  // Only when off: the default keeps the run ids of configs written before the key.
+  if (!f.clamp_log_range) o["clamp_log_range"] = false;
   o["solve_last"] = f.solve_last;
   o["solver"] = solver;
 }
@@ -175,7 +181,9 @@ void fill_homomorphic_row(const RunContext& c, MethodOutcome& out, Row& row) {
   std::vector<std::string> ec;
   for (double v : run.errors_after_term) ec.push_back(format_number(v));
   row["errors_after_term"] = join(ec, ";");
-  out.record["reconstruction"] = h.subtract_eps() ? "A exp(s) - eps A, clamped at 0" : "A exp(s)";
+  out.record["reconstruction"] =
+      std::string(h.log_range() ? "A exp(clamp(s, log_range)" : "A exp(s") +
+      (h.subtract_eps() ? ") - eps A, clamped at 0" : ")");
   if (c.method.refine == "none") return;
   row["refine"] = c.method.refine;
   row["refine_seconds"] = format_number(std::round(run.refine_seconds * 1000.0) / 1000.0);

@@ -306,7 +306,7 @@ void bind_methods(py::module_& m) {
 
 McCool's fixed projections (p(wi) p(h) p(wo), two textures). Options: the keys
 of a config's kind = "mccool" (docs/experiments.md), e.g. texture_size (or
-"auto" with tolerance and texture_ladder), eps, smoothing, subtract_eps,
+"auto" with tolerance and texture_ladder), eps, smoothing, subtract_eps, clamp_log_range,
 solve_last, solver, refine ("none" | "linear" | "cosine" | "blend"),
 refine_blend, refine_iterations, refine_smoothing; and metric_eps (the
 experiment's).)doc");

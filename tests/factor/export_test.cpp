@@ -3,6 +3,7 @@
 // generated GLSL compiled by glslangValidator.
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -81,7 +82,11 @@ FactorTerm make_term(const Projection& p, bool reciprocal, std::mt19937_64& rng)
 
 // Three terms: a wiwo term with a random orthonormal projection (and a
 // quaternion pair), a reciprocal halfdiff term, a reciprocal wiwo term.
-HomomorphicFactorization make_factorization(bool subtract_eps = true) {
+std::vector<std::pair<Vec3, Vec3>> direction_pairs();
+
+// ranged: with a log range (docs/design.md §3.2) at the 20th and 80th
+// percentiles of the unclamped log value over direction_pairs(), per channel.
+HomomorphicFactorization make_factorization(bool subtract_eps = true, bool ranged = false) {
   std::mt19937_64 rng(2024);
   std::vector<FactorTerm> terms;
   Projection p0;
@@ -96,8 +101,17 @@ HomomorphicFactorization make_factorization(bool subtract_eps = true) {
   p1.res = 12;
   terms.push_back(make_term(p1, true, rng));
   terms.push_back(make_term(projection_first_pair(Parameterization::WiWo, 8), true, rng));
-  return HomomorphicFactorization(std::move(terms), Rgb(0.3, 0.5, 0.7), 1e-5, subtract_eps,
-                                  "fit");
+  HomomorphicFactorization f(terms, Rgb(0.3, 0.5, 0.7), 1e-5, subtract_eps, "fit");
+  if (!ranged) return f;
+  LogRange range;
+  const auto pairs = direction_pairs();
+  for (int c = 0; c < 3; ++c) {
+    std::vector<double> v;
+    for (const auto& [wi, wo] : pairs) v.push_back(f.eval_log(wi, wo)[c]);
+    std::sort(v.begin(), v.end());
+    range[c] = {v[v.size() / 5], v[4 * v.size() / 5]};
+  }
+  return HomomorphicFactorization(std::move(terms), Rgb(0.3, 0.5, 0.7), 1e-5, subtract_eps, "fit", range);
 }
 
 Vec3 random_upper(std::mt19937_64& rng) {
@@ -161,8 +175,10 @@ void write_exr(const std::string& path, int w, int h, int channels, const std::v
 }  // namespace
 
 TEST_CASE("export: reload evaluates bit-identically to the in-memory factorization") {
-  for (bool subtract_eps : {true, false}) {
-    const HomomorphicFactorization f = make_factorization(subtract_eps);
+  for (int variant = 0; variant < 4; ++variant) {
+    const bool subtract_eps = variant % 2 == 0, ranged = variant >= 2;
+    INFO("subtract_eps " << subtract_eps << ", log range " << ranged);
+    const HomomorphicFactorization f = make_factorization(subtract_eps, ranged);
     TempDir dir;
     const ExportedFiles files = write_factorization(f, dir.path.string(), "factors");
     for (const std::string& p : files.textures) CHECK(fs::exists(p));
@@ -178,6 +194,8 @@ TEST_CASE("export: reload evaluates bit-identically to the in-memory factorizati
     CHECK(g->subtract_eps() == f.subtract_eps());
     CHECK(g->eps() == f.eps());
     CHECK((g->A() == f.A()).all());
+    CHECK(g->log_range() == f.log_range());
+    CHECK(g->log_range().has_value() == ranged);
     REQUIRE(g->terms().size() == f.terms().size());
     for (size_t k = 0; k < f.terms().size(); ++k) {
       const FactorTerm &a = f.terms()[k], &b = g->terms()[k];
@@ -444,15 +462,49 @@ TEST_CASE("export: generated GLSL compiles for GL 3.3, GL 4.5, GLES 3.0 and Vulk
   // Installed by scripts/install-deps.sh (glslang-tools): missing, the test fails.
   INFO("glslangValidator not found: scripts/install-deps.sh installs glslang-tools");
   REQUIRE(std::system("command -v glslangValidator > /dev/null 2>&1") == 0);
-  TempDir dir;
-  const HomomorphicFactorization f = make_factorization();
-  const ExportedFiles files = write_factorization(f, dir.path.string(), "factors");
-  const std::string glsl = read_text(files.glsl);
-  CHECK_THAT(glsl, Contains("vec3 brdf_factor_eval(vec3 wi, vec3 wo)"));
-  const std::string err =
-      bf_test::compile_glsl_all_targets(glsl, dir.path, "#define BRDF_FACTOR_EXACT_BILINEAR\n");
-  INFO(err);
-  CHECK(err.empty());
+  for (const bool ranged : {false, true}) {
+    TempDir dir;
+    const HomomorphicFactorization f = make_factorization(true, ranged);
+    const ExportedFiles files = write_factorization(f, dir.path.string(), "factors");
+    const std::string glsl = read_text(files.glsl);
+    CHECK_THAT(glsl, Contains("vec3 brdf_factor_eval(vec3 wi, vec3 wo)"));
+    CHECK((glsl.find("g = clamp(g, ") != std::string::npos) == ranged);
+    const std::string err =
+        bf_test::compile_glsl_all_targets(glsl, dir.path, "#define BRDF_FACTOR_EXACT_BILINEAR\n");
+    INFO("log range " << ranged << ": " << err);
+    CHECK(err.empty());
+  }
+}
+
+TEST_CASE("export: a bad log_range is refused naming the field, an absent one means no clamp") {
+  SECTION("lo > hi") {
+    TempDir dir;
+    const std::string p = corrupted_export(dir, [](json& j) { j["log_range"] = {{0, 1}, {2, 1}, {0, 1}}; });
+    REQUIRE_THROWS_WITH(load_factorization(p), Contains(p) && Contains("field 'log_range[1]'") &&
+                                                   Contains("lo <= hi"));
+  }
+  SECTION("not a number, wrong shape") {
+    TempDir dir;
+    const std::string p = corrupted_export(dir, [](json& j) { j["log_range"] = {{0, 1}, {0, 1}, {0, "x"}}; });
+    REQUIRE_THROWS_WITH(load_factorization(p), Contains("field 'log_range[2][1]'") && Contains("finite number"));
+    TempDir dir2;
+    const std::string q = corrupted_export(dir2, [](json& j) { j["log_range"] = {{0, 1}, {0, 1}}; });
+    REQUIRE_THROWS_WITH(load_factorization(q), Contains("field 'log_range'") && Contains("array of 2"));
+  }
+  SECTION("absent (an export from before the clamp)") {
+    TempDir dir;
+    const HomomorphicFactorization f = make_factorization(true, true);
+    const ExportedFiles files = write_factorization(f, dir.path.string(), "factors");
+    json j = read_json(files.sidecar);
+    REQUIRE(j.contains("log_range"));
+    j.erase("log_range");
+    write_json(files.sidecar, j);
+    const auto g = load_factorization(files.sidecar);
+    CHECK(!g->log_range());
+    size_t differ = 0;
+    for (const auto& [wi, wo] : direction_pairs()) differ += (g->eval(wi, wo) != f.eval(wi, wo)).any();
+    CHECK(differ > 0);  // unclamped: the range was binding
+  }
 }
 
 namespace {
@@ -585,25 +637,43 @@ TEST_CASE("export: texture orientation holds through write, read, eval and the G
     for (const auto& [wi, wo] : pairs)
       d << wi.x() << " " << wi.y() << " " << wi.z() << " " << wo.x() << " " << wo.y() << " " << wo.z() << "\n";
   }
-  for (const bool exact : {true, false}) {
-    std::string cmd = runner.string() + " " + files.glsl + " " + (dir / "dirs.txt") + " " + (dir / "out.txt") +
+  // The same terms with a log range that binds on both sides at about a
+  // quarter of the pairs each (the log-range clamp, docs/design.md §3.2).
+  LogRange range;
+  for (int c = 0; c < 3; ++c) {
+    std::vector<double> v;
+    for (const auto& [wi, wo] : pairs) v.push_back(f.eval_log(wi, wo)[c]);
+    std::sort(v.begin(), v.end());
+    range[c] = {v[v.size() / 4], v[3 * v.size() / 4]};
+  }
+  const HomomorphicFactorization fr(terms, f.A(), f.eps(), true, "fit", range);
+  fs::create_directories(dir / "ranged");
+  const ExportedFiles rfiles = write_factorization(fr, dir / "ranged", "orient");
+  for (int variant = 0; variant < 4; ++variant) {
+    const bool exact = variant % 2 == 0, ranged = variant >= 2;
+    const HomomorphicFactorization& fv = ranged ? fr : f;
+    const ExportedFiles& fl = ranged ? rfiles : files;
+    std::string cmd = runner.string() + " " + fl.glsl + " " + (dir / "dirs.txt") + " " + (dir / "out.txt") +
                       (exact ? " --exact" : "");
-    for (const auto& t : files.textures) cmd += " " + t;
+    for (const auto& t : fl.textures) cmd += " " + t;
     cmd += " > " + (dir / "run.log") + " 2>&1";
     const int rc = std::system(cmd.c_str());
-    INFO((exact ? "texelFetch path" : "hardware bilinear path") << ": " << read_text(dir / "run.log"));
+    INFO((exact ? "texelFetch path" : "hardware bilinear path") << (ranged ? ", log range clamped" : "") << ": "
+                                                                   << read_text(dir / "run.log"));
     REQUIRE(rc == 0);
     std::ifstream out(dir / "out.txt");
     double worst = 0.0;
-    size_t n = 0;
+    size_t n = 0, clamped = 0;
     for (const auto& [wi, wo] : pairs) {
       Rgb gpu;
       REQUIRE(out >> gpu[0] >> gpu[1] >> gpu[2]);
-      const Rgb cpu = f.eval(wi, wo);
+      const Rgb cpu = fv.eval(wi, wo);
+      clamped += (fv.eval(wi, wo) != f.eval(wi, wo)).any();
       worst = std::max(worst, ((gpu - cpu).abs() / cpu.abs()).maxCoeff());
       ++n;
     }
     CHECK(n == pairs.size());
+    if (ranged) CHECK(clamped > pairs.size() / 4);  // the clamp binds: the GLSL must apply it
     // Measured 5.4e-7 on both paths (float arithmetic; llvmpipe's GL_LINEAR
     // weights are full float). A transposed or shifted lookup is off by
     // O(0.1) per texel in log space. (A GPU with 8-bit filter weights would

@@ -80,6 +80,11 @@ TEST_CASE("fit: RMS log error falls about 4x per doubling of texture resolution"
   FitOptions opt;
   opt.solve_last = 3;
   opt.smoothing = 1e-7;
+  // The log-range clamp (docs/design.md §3.2) caps held-out samples whose
+  // target lies beyond the training targets' range at that range: an error
+  // that does not shrink with the texture (measured 0.00191 -> 0.00138 rms,
+  // ratio 1.38, at 16 -> 32 with it). This test is about the bilinear model.
+  opt.clamp_log_range = false;
   const FitData d(fit_s, opt.eps);
   std::vector<double> rms;
   for (int res : {8, 16, 32}) {
@@ -101,6 +106,7 @@ TEST_CASE("fit: convergence continues to texture 64", "[slow]") {
   FitOptions opt;
   opt.solve_last = 3;
   opt.smoothing = 1e-7;
+  opt.clamp_log_range = false;  // as in the test above
   const FitData d(fit_s, opt.eps);
   const double r32 =
       std::sqrt(evaluate_metrics(*fit_homomorphic(d, planted_terms(32), opt), held, d.transform).rel_mse);
@@ -263,6 +269,7 @@ TEST_CASE("fit: the search objective read off the normal equations equals the sa
   const SampleSet s = sample_stratified(brdf, 5000, 29);
   std::mt19937_64 rng(31);
   FitOptions opt;
+  opt.clamp_log_range = false;  // the exact pass would see the clamp, the objective does not
   const FitData d(s, opt.eps);
   for (bool recip : {false, true}) {
     std::vector<TermSpec> joint = {
