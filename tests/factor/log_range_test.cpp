@@ -9,64 +9,14 @@
 #include "brdfs/sampleset.h"
 #include "factor/homomorphic_fit.h"
 #include "factor/metrics.h"
+#include "extrapolation_helpers.h"
 #include "fit_helpers.h"
 #include "test_common.h"
 
 using namespace bf;
 using Catch::Matchers::Contains;
 
-namespace {
-
-// Directions at the centres of a g x g grid of equal-solid-angle cells.
-std::vector<Vec3> hemisphere_grid(int g) {
-  std::vector<Vec3> out;
-  for (int t = 0; t < g; ++t)
-    for (int p = 0; p < g; ++p) {
-      const double ct = (t + 0.5) / g, st = std::sqrt(1 - ct * ct), ph = 2 * M_PI * (p + 0.5) / g;
-      out.emplace_back(st * std::cos(ph), st * std::sin(ph), ct);
-    }
-  return out;
-}
-
-// max over a 12^4 grid of pairs and the channels of approx_c / max of original_c.
-double max_ratio(const Brdf& approx, const Brdf& original) {
-  const std::vector<Vec3> dirs = hemisphere_grid(12);
-  Rgb omax = Rgb::Zero(), amax = Rgb::Zero();
-  for (const Vec3& wi : dirs)
-    for (const Vec3& wo : dirs) {
-      omax = omax.max(original.eval(wi, wo));
-      amax = amax.max(approx.eval(wi, wo));
-    }
-  return (amax / omax).maxCoeff();
-}
-
-// Samples in part of the domain only: wi in the plane phi_i = 0, theta_i and
-// theta_o up to max_theta degrees, values times exp(noise * N(0, 1)).
-SampleSet sparse_samples(const Brdf& b, size_t n, double max_theta, double noise, uint64_t seed) {
-  std::mt19937_64 rng(seed);
-  std::uniform_real_distribution<double> U(0.0, 1.0);
-  std::normal_distribution<double> Z(0.0, 1.0);
-  SampleSet s;
-  const double cmin = std::cos(max_theta * M_PI / 180.0);
-  for (size_t k = 0; k < n; ++k) {
-    const double ti = std::acos(cmin + (1 - cmin) * U(rng));
-    const double co = cmin + (1 - cmin) * U(rng), so = std::sqrt(1 - co * co), po = 2 * M_PI * U(rng);
-    const Vec3 wi(std::sin(ti), 0.0, std::cos(ti)), wo(so * std::cos(po), so * std::sin(po), co);
-    s.wi.push_back(wi);
-    s.wo.push_back(wo);
-    s.value.push_back(b.eval(wi, wo) * std::exp(noise * Z(rng)));
-    s.valid.push_back(1);
-  }
-  return s;
-}
-
-std::vector<TermSpec> random_wiwo_terms(int res, uint64_t seed) {
-  std::mt19937_64 rng(seed);
-  return {{bf_test::random_projection(rng, Parameterization::WiWo, res), false, std::nullopt},
-          {bf_test::random_projection(rng, Parameterization::WiWo, res), false, std::nullopt}};
-}
-
-}  // namespace
+using namespace bf_test;
 
 TEST_CASE("log range: the fit records min and max of its log targets, and the clamp leaves the texels alone") {
   const bf_test::PlantedBrdf brdf;
