@@ -7,6 +7,7 @@
 // (experiments/runner.cpp execute_run: MethodKind::run), in a LongCall (GIL
 // released, Ctrl-C cancels), and reports metrics on the samples like a
 // results row.
+#include <algorithm>
 #include <chrono>
 #include <toml++/toml.h>
 
@@ -78,13 +79,13 @@ bool to_toml(const py::handle& v, toml::table* t, const std::string& key, toml::
 // Python's shorthands for a config's tables: tolerance = ("rel_mse", 0.01) for
 // { metric = "rel_mse", value = 0.01 }; a projection of kind "fit" as a name
 // ("wi") for { name = "wi" } or a 2x4 matrix for { matrix = ... }.
-py::object config_form(const std::string& kind, const std::string& key, const py::object& v) {
+py::object config_form(const std::string& key, const py::object& v) {
   const auto pair = [](const py::object& o) {
     return (py::isinstance<py::tuple>(o) || py::isinstance<py::list>(o)) && py::len(o) == 2 &&
            py::isinstance<py::str>(o[py::int_(0)]);
   };
   if (key == "tolerance" && pair(v)) return py::dict(py::arg("metric") = v[py::int_(0)], py::arg("value") = v[py::int_(1)]);
-  if (kind == "fit" && key == "projections" && (py::isinstance<py::list>(v) || py::isinstance<py::tuple>(v))) {
+  if (key == "projections" && (py::isinstance<py::list>(v) || py::isinstance<py::tuple>(v))) {
     py::list out;
     for (auto e : v) {
       if (py::isinstance<py::str>(e)) out.append(py::dict(py::arg("name") = e));
@@ -120,7 +121,11 @@ py::object config_form(const std::string& kind, const std::string& key, const py
 void reject_table_keys(const std::string& kind, const std::string& key) {
   if (key == "kind" || key == "label" || key == "zip")
     throw std::invalid_argument(kind + ": " + key + ": names or sweeps a config's [[method]] table; a call takes options only");
-  if (kind == "sh-r" && key == "shrm")
+  const MethodKind* k = find_method_kind(kind);
+  const std::vector<KeySpec> keys = k ? k->keys() : std::vector<KeySpec>{};
+  const bool has_shrm =
+      std::any_of(keys.begin(), keys.end(), [](const KeySpec& spec) { return spec.name == "shrm"; });
+  if (key == "shrm" && has_shrm)
     throw std::invalid_argument(kind + ": shrm: the SHRM needs an experiment's [scene] lighting: run a config with bf.run()");
 }
 
@@ -143,7 +148,7 @@ MethodCall read_call(const std::string& kind, const py::kwargs& kw) {
     reject_table_keys(kind, key);
     if (item.second.is_none()) continue;  // None: the default
     toml::table& dst = key == "metric_eps" ? experiment : method;
-    const py::object v = config_form(kind, key, py::reinterpret_borrow<py::object>(item.second));
+    const py::object v = config_form(key, py::reinterpret_borrow<py::object>(item.second));
     if (!to_toml(v, &dst, key, nullptr))
       throw std::invalid_argument(kind + ": " + key +
                                   ": expected a value a config holds (a number, string, bool, list or dict), found " +
@@ -186,8 +191,8 @@ std::shared_ptr<PyFactorization> run_kind(const MethodCall& call, const BrdfPtr&
     const SampleSet none;
     const SampleSet& s = samples ? *samples : none;
     const LogTransform lt = samples ? LogTransform::of(s, call.metric_eps) : LogTransform{Rgb::Ones(), call.metric_eps};
-    // The isotropy test decides SH-K's reduction; the other kinds do not read it.
-    const IsotropyResult iso = brdf && m.kind == "sh-k" ? test_isotropy(*brdf) : IsotropyResult{};
+    // The azimuthal-invariance test, as the runner makes it for every run (SH-K's reduction reads it).
+    const IsotropyResult iso = brdf ? test_isotropy(*brdf) : IsotropyResult{};
     const Plan plan;
     const PlannedRun run;
     BrdfVariant b;
@@ -210,7 +215,7 @@ std::shared_ptr<PyFactorization> run_kind(const MethodCall& call, const BrdfPtr&
       for (int k = 1; k <= svd->rank(); ++k)
         p->errors_after_term.push_back(evaluate_metrics(*svd->truncated(k), s, lt).rel_mse);
     }
-    if (m.kind == "sh-k") p->info["isotropic"] = iso.isotropic;
+    if (brdf) p->info["isotropic"] = iso.isotropic;
     if (out.choice) p->info["size_choice"] = choice_record(*out.choice);
     if (!out.notes.empty()) p->info["notes"] = out.notes;
   }
