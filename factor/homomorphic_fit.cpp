@@ -1,5 +1,6 @@
 // Homomorphic least-squares fit (see homomorphic_fit.h for the formulation).
 #include "factor/homomorphic_fit.h"
+#include "factor/assembly_kernels.h"
 #include "factor/dense_kernels.h"
 #include "solvers/cancel.h"
 #include "solvers/option_error.h"
@@ -185,31 +186,21 @@ void add_layout(const FitData& d, const TermSpec& s, int& M, std::vector<TermLay
                &d.points(s.proj.param), {}, projection_mask(s.proj), 0, 0};
   const std::vector<Vec4>& x = *t.x;
   const int R = s.proj.res;
+  thread_local std::vector<uint8_t> touched;  // cells a sample falls into
   for (int h = 0; h < (t.reciprocal ? 2 : 1); ++h) {
     const FastProj& fp = h == 0 ? t.proj : t.conj;
     Lookups& L = lk[h];
     L.cell.resize(N);
     L.fa.resize(N);
     L.fb.resize(N);
-    const double m00 = fp.M(0, 0), m01 = fp.M(0, 1), m02 = fp.M(0, 2), m03 = fp.M(0, 3);
-    const double m10 = fp.M(1, 0), m11 = fp.M(1, 1), m12 = fp.M(1, 2), m13 = fp.M(1, 3);
-    const double off = fp.off, top = double(R - 1);
-    int* cell = L.cell.data();
-    double* fa = L.fa.data();
-    double* fb = L.fb.data();
-    uint8_t* mask = t.mask.data();
-    for (size_t k = 0; k < N; ++k) {
-      const double* xk = x[k].data();
-      // Same sums in the same order as M.row(r).dot(x) + off.
-      const double u = std::clamp(m00 * xk[0] + m01 * xk[1] + m02 * xk[2] + m03 * xk[3] + off, 0.0, top);
-      const double v = std::clamp(m10 * xk[0] + m11 * xk[1] + m12 * xk[2] + m13 * xk[3] + off, 0.0, top);
-      const int i = std::min(static_cast<int>(u), R - 2), j = std::min(static_cast<int>(v), R - 2);
-      const int c = j * R + i;
-      cell[k] = c;
-      fa[k] = u - i;
-      fb[k] = v - j;
-      mask[c] = mask[c + 1] = mask[c + R] = mask[c + R + 1] = 1;
-    }
+    const double m[8] = {fp.M(0, 0), fp.M(0, 1), fp.M(0, 2), fp.M(0, 3),
+                         fp.M(1, 0), fp.M(1, 1), fp.M(1, 2), fp.M(1, 3)};
+    touched.assign(size_t(R) * R, 0);
+    kernels::lookup_cells(N, x.empty() ? nullptr : x[0].data(), m, fp.off, R, L.cell.data(), L.fa.data(),
+                          L.fb.data(), touched.data());
+    // Every texel a sample reads joins the mask: the 4 corners of each touched cell.
+    for (int c = 0; c < R * R; ++c)
+      if (touched[c]) t.mask[c] = t.mask[c + 1] = t.mask[c + R] = t.mask[c + R + 1] = 1;
   }
   t.unk.assign(t.mask.size(), -1);
   t.first = M;
@@ -219,13 +210,6 @@ void add_layout(const FitData& d, const TermSpec& s, int& M, std::vector<TermLay
   terms.push_back(std::move(t));
 }
 
-// Per-cell sums of one lookup's self-products: the 10 entries of the 4x4
-// product of its bilinear weights and the 4x3 right-hand side sums.
-struct CellAcc {
-  double q[10];  // (0,0) (1,0) (2,0) (3,0) (1,1) (2,1) (3,1) (2,2) (3,2) (3,3)
-  double r[4][3];
-};
-
 // Scratch buffers of the dense path, one set per thread, reused across fits so
 // that the search's inner loop does not allocate (glibc returns the large
 // normal matrix to the OS with munmap at every free, and every fit then paid
@@ -233,7 +217,7 @@ struct CellAcc {
 // live here; nothing is carried from one fit to the next.
 struct Workspace {
   std::vector<double> A;                    // normal matrix, M x M column-major
-  std::vector<CellAcc> cells;               // per-cell sums, all new lookups
+  std::vector<double> cells;                // per-cell sums of one lookup (kernels::cell_sums)
   std::vector<int> corners;                 // per lookup and cell: its 4 unknowns
   std::array<std::vector<double>, 3> r;     // residual targets g - fixed, per channel
   std::vector<std::array<Lookups, 2>> own;  // lookups of the terms not in a prefix
@@ -341,26 +325,9 @@ void assemble_dense(const FitData& d, const std::array<const double*, 3>& r,
     for (int q = std::max(p + 1, first_new_sub); q < S; ++q) {
       const Lookups& lp = *subs[p].lk;
       const Lookups& lq = *subs[q].lk;
-      const int* cnp = ws.corners.data() + subs[p].corners;
-      const int* cnq = ws.corners.data() + subs[q].corners;
-      for (size_t k = 0; k < N; ++k) {
-        const double a = lp.fa[k], b = lp.fb[k];
-        const double wk = w[k];
-        const double sp[4] = {wk * ((1 - a) * (1 - b)), wk * (a * (1 - b)), wk * ((1 - a) * b), wk * (a * b)};
-        const double c2 = lq.fa[k], d2 = lq.fb[k];
-        const double sq[4] = {(1 - c2) * (1 - d2), c2 * (1 - d2), (1 - c2) * d2, c2 * d2};
-        const int* ip = cnp + 4 * lp.cell[k];
-        const int* iq = cnq + 4 * lq.cell[k];
-        const int q0 = iq[0], q1 = iq[1], q2 = iq[2], q3 = iq[3];
-        for (int a2 = 0; a2 < 4; ++a2) {
-          double* col = Ad + static_cast<size_t>(ip[a2]) * MM;
-          const double wa = sp[a2];
-          col[q0] += wa * sq[0];
-          col[q1] += wa * sq[1];
-          col[q2] += wa * sq[2];
-          col[q3] += wa * sq[3];
-        }
-      }
+      kernels::cross_products(N, lp.cell.data(), lp.fa.data(), lp.fb.data(), lq.cell.data(), lq.fa.data(),
+                              lq.fb.data(), w, ws.corners.data() + subs[p].corners,
+                              ws.corners.data() + subs[q].corners, Ad, MM);
     }
   // Fold reciprocal terms' upper-triangle entries into the lower triangle.
   // Each cross product s_p s_q^T was added once; the symmetric pair
@@ -382,42 +349,22 @@ void assemble_dense(const FitData& d, const std::array<const double*, 3>& r,
   for (int p = first_new_sub; p < S; ++p) {
     const TermLayout& t = terms[subs[p].term];
     const int R = t.proj.res;
-    ws.cells.assign(size_t(R) * R, CellAcc{});
-    CellAcc* cells = ws.cells.data();
+    ws.cells.assign(size_t(R) * R * kernels::kCellDoubles, 0.0);
     const Lookups& lk = *subs[p].lk;
-    const int* cell = lk.cell.data();
-    const double* fa = lk.fa.data();
-    const double* fb = lk.fb.data();
-    const double* r0 = r[0];
-    const double* r1 = r[1];
-    const double* r2 = r[2];
-    for (size_t k = 0; k < N; ++k) {
-      const double a = fa[k], b = fb[k], wk = w[k];
-      const double b0 = (1 - a) * (1 - b), b1 = a * (1 - b), b2 = (1 - a) * b, b3 = a * b;
-      CellAcc& acc = cells[cell[k]];
-      const double wb0 = wk * b0, wb1 = wk * b1, wb2 = wk * b2, wb3 = wk * b3;
-      acc.q[0] += wb0 * b0; acc.q[1] += wb1 * b0; acc.q[2] += wb2 * b0; acc.q[3] += wb3 * b0;
-      acc.q[4] += wb1 * b1; acc.q[5] += wb2 * b1; acc.q[6] += wb3 * b1;
-      acc.q[7] += wb2 * b2; acc.q[8] += wb3 * b2; acc.q[9] += wb3 * b3;
-      const double rk[3] = {r0[k], r1[k], r2[k]};
-      for (int c = 0; c < 3; ++c) {
-        acc.r[0][c] += wb0 * rk[c]; acc.r[1][c] += wb1 * rk[c];
-        acc.r[2][c] += wb2 * rk[c]; acc.r[3][c] += wb3 * rk[c];
-      }
-    }
+    kernels::cell_sums(N, lk.cell.data(), lk.fa.data(), lk.fb.data(), w, r[0], r[1], r[2], ws.cells.data());
     // Scatter the per-cell sums into the lower triangle and the right-hand side.
-    for (size_t c0 = 0; c0 < ws.cells.size(); ++c0) {
-      const CellAcc& acc = cells[c0];
-      if (acc.q[0] == 0 && acc.q[4] == 0 && acc.q[7] == 0 && acc.q[9] == 0) continue;
+    const int pairs[10][2] = {{0, 0}, {1, 0}, {2, 0}, {3, 0}, {1, 1},
+                              {2, 1}, {3, 1}, {2, 2}, {3, 2}, {3, 3}};
+    for (size_t c0 = 0; c0 < size_t(R) * R; ++c0) {
+      const double* acc = ws.cells.data() + c0 * kernels::kCellDoubles;  // Q (i, j) at 4 j + i, R at 16 + 4 c + v
+      if (acc[0] == 0 && acc[5] == 0 && acc[10] == 0 && acc[15] == 0) continue;
       const int id[4] = {t.unk[c0], t.unk[c0 + 1], t.unk[c0 + R], t.unk[c0 + R + 1]};
-      const int pairs[10][2] = {{0, 0}, {1, 0}, {2, 0}, {3, 0}, {1, 1},
-                                {2, 1}, {3, 1}, {2, 2}, {3, 2}, {3, 3}};
-      for (int e = 0; e < 10; ++e) {
-        const int i = id[pairs[e][0]], j = id[pairs[e][1]];
-        A(std::max(i, j), std::min(i, j)) += acc.q[e];
+      for (const auto& e : pairs) {
+        const int i = id[e[0]], j = id[e[1]];
+        A(std::max(i, j), std::min(i, j)) += acc[4 * e[1] + e[0]];
       }
       for (int v = 0; v < 4; ++v)
-        for (int c = 0; c < 3; ++c) rhs(id[v], c) += acc.r[v][c];
+        for (int c = 0; c < 3; ++c) rhs(id[v], c) += acc[16 + 4 * c + v];
     }
   }
 
