@@ -8,23 +8,28 @@ namespace bf::kernels {
 
 namespace generic {
 bool llt_solve(double* A, long n, double* B, long nrhs);
+bool llt_solve_banded_head(double* A, long n, long n1, double* B, long nrhs);
 }
 #ifdef BF_FACTOR_X86_KERNELS
 namespace avx2 {
 bool llt_solve(double* A, long n, double* B, long nrhs);
+bool llt_solve_banded_head(double* A, long n, long n1, double* B, long nrhs);
 }
 namespace avx512 {
 bool llt_solve(double* A, long n, double* B, long nrhs);
+bool llt_solve_banded_head(double* A, long n, long n1, double* B, long nrhs);
 }
 #endif
 
 namespace {
 
 using LltFn = bool (*)(double*, long, double*, long);
+using BandedFn = bool (*)(double*, long, long, double*, long);
 
 struct Variant {
   const char* name;
   LltFn llt;
+  BandedFn banded;
   bool (*supported)();
 };
 
@@ -39,10 +44,10 @@ bool has_avx512() {
 #endif
 
 const Variant kVariants[] = {
-    {"generic", &generic::llt_solve, &always},
+    {"generic", &generic::llt_solve, &generic::llt_solve_banded_head, &always},
 #ifdef BF_FACTOR_X86_KERNELS
-    {"avx2", &avx2::llt_solve, &has_avx2},
-    {"avx512", &avx512::llt_solve, &has_avx512},
+    {"avx2", &avx2::llt_solve, &avx2::llt_solve_banded_head, &has_avx2},
+    {"avx512", &avx512::llt_solve, &avx512::llt_solve_banded_head, &has_avx512},
 #endif
 };
 
@@ -84,6 +89,10 @@ const Variant& chosen() {
 
 bool llt_solve(double* A, long n, double* B, long nrhs) { return chosen().llt(A, n, B, nrhs); }
 
+bool llt_solve_banded_head(double* A, long n, long n1, double* B, long nrhs) {
+  return chosen().banded(A, n, n1, B, nrhs);
+}
+
 std::string active_variant() { return chosen().name; }
 
 std::vector<std::string> supported_variants() {
@@ -95,6 +104,10 @@ std::vector<std::string> supported_variants() {
 
 bool llt_solve_with(const std::string& variant, double* A, long n, double* B, long nrhs) {
   return find(variant).llt(A, n, B, nrhs);
+}
+
+bool llt_solve_banded_head_with(const std::string& variant, double* A, long n, long n1, double* B, long nrhs) {
+  return find(variant).banded(A, n, n1, B, nrhs);
 }
 
 }  // namespace bf::kernels

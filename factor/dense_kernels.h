@@ -23,6 +23,14 @@ namespace bf::kernels {
 // numerically positive definite.
 bool llt_solve(double* A, long n, double* B, long nrhs);
 
+// llt_solve for a matrix whose leading n1 x n1 block is banded (the fit's first
+// joint term: bilinear cells and Laplacian couple texels at most 2 rows apart).
+// That block is factored in band storage order, the n - n1 trailing unknowns
+// through the Schur complement A22 - L21 L21^T (dense). The same factorization
+// as llt_solve up to rounding; falls back to llt_solve when the head's
+// bandwidth exceeds n1 / 4 or n1 is 0 or n.
+bool llt_solve_banded_head(double* A, long n, long n1, double* B, long nrhs);
+
 // The variant llt_solve uses: "generic", "avx2" (AVX2 + FMA) or "avx512"
 // (AVX-512 F/DQ/VL + AVX2 + FMA). Chosen once, on first use: avx2 if the CPU
 // (and the OS) support it, else generic, unless the environment variable
@@ -37,5 +45,6 @@ std::vector<std::string> supported_variants();
 // llt_solve with a given variant. Throws std::invalid_argument naming the
 // variant if it is unknown or this CPU cannot run it.
 bool llt_solve_with(const std::string& variant, double* A, long n, double* B, long nrhs);
+bool llt_solve_banded_head_with(const std::string& variant, double* A, long n, long n1, double* B, long nrhs);
 
 }  // namespace bf::kernels

@@ -734,7 +734,13 @@ JointSolution solve_joint(const FitData& d, const std::array<std::vector<double>
     // In place, one factorization for the 3 channels; the CPU's widest
     // instruction set (factor/dense_kernels.h).
     Y = rhs;
-    const bool pd = kernels::llt_solve(A.data(), M, Y.data(), 3);
+    // The first joint term's own block is banded (a sample couples the 4
+    // corners of its cell, the Laplacian texels two rows apart) unless the
+    // term is reciprocal (its conjugate lookups couple distant texels) or the
+    // extrapolation prior's level rows couple a term's unreached texels.
+    const bool banded_head = terms.size() > 1 && !terms[0].reciprocal && !prior.on();
+    const bool pd = banded_head ? kernels::llt_solve_banded_head(A.data(), M, terms[0].count, Y.data(), 3)
+                                : kernels::llt_solve(A.data(), M, Y.data(), 3);
     ws.trim();
     if (!pd)
       throw std::runtime_error("fit: the normal matrix is not positive definite (" +

@@ -60,3 +60,54 @@ TEST_CASE("dense kernels: an unknown variant is refused with the known ones name
   CHECK_THROWS_WITH(kernels::llt_solve_with("sse9", &a, 1, &b, 1),
                     Catch::Contains("expected one of generic") && Catch::Contains("found \"sse9\""));
 }
+
+namespace {
+// A random SPD matrix whose leading n1 x n1 block has bandwidth bw (zero
+// beyond), the rest dense: B B^T + diagonal with B of that sparsity pattern
+// does not keep the band, so the head block is built as a banded SPD matrix
+// and the coupling kept small enough for positive definiteness.
+Eigen::MatrixXd banded_head_spd(int n, int n1, int bw, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> ud(-1.0, 1.0);
+  Eigen::MatrixXd A = Eigen::MatrixXd::Zero(n, n);
+  for (int j = 0; j < n; ++j)
+    for (int i = j + 1; i < n; ++i)
+      if (i >= n1 || i - j <= bw) A(i, j) = A(j, i) = ud(rng);
+  for (int j = 0; j < n; ++j) A(j, j) = (j < n1 ? 2 * bw + 2 : n) + 1.0;  // diagonally dominant
+  return A;
+}
+}  // namespace
+
+TEST_CASE("dense kernels: the banded-head Cholesky solves like Eigen's LLT, for every variant") {
+  // (n, n1, bw): band used (4 bw <= n1), a full band (falls back), the head
+  // being everything but one unknown, a band of width 0.
+  const int cases[][3] = {{60, 30, 5}, {300, 150, 20}, {100, 40, 30}, {50, 49, 3}, {40, 20, 0}};
+  for (const auto& c : cases) {
+    const int n = c[0], n1 = c[1], bw = c[2];
+    const Eigen::MatrixXd A = banded_head_spd(n, n1, bw, 7u + n + bw);
+    const Eigen::MatrixXd B = Eigen::MatrixXd::Random(n, 3);
+    const Eigen::MatrixXd ref = A.llt().solve(B);
+    for (const std::string& v : kernels::supported_variants()) {
+      INFO("variant " << v << ", n = " << n << ", n1 = " << n1 << ", bw = " << bw);
+      Eigen::MatrixXd a = A;
+      a.triangularView<Eigen::StrictlyUpper>().setConstant(1e300);  // only the lower triangle is read
+      Eigen::MatrixXd x = B;
+      REQUIRE(kernels::llt_solve_banded_head_with(v, a.data(), n, n1, x.data(), 3));
+      CHECK((x - ref).norm() <= 1e-12 * ref.norm());
+      CHECK((A * x - B).norm() <= 1e-10 * B.norm());
+    }
+  }
+}
+
+TEST_CASE("dense kernels: the banded-head Cholesky reports a matrix that is not positive definite") {
+  // Once in the banded head, once in the Schur complement.
+  for (int bad : {10, 45}) {
+    Eigen::MatrixXd A = banded_head_spd(60, 30, 4, 11u);
+    A(bad, bad) = -1.0;
+    for (const std::string& v : kernels::supported_variants()) {
+      INFO("variant " << v << ", negative diagonal at " << bad);
+      Eigen::MatrixXd a = A, x = Eigen::MatrixXd::Ones(60, 2);
+      CHECK_FALSE(kernels::llt_solve_banded_head_with(v, a.data(), 60, 30, x.data(), 2));
+    }
+  }
+}
