@@ -68,20 +68,26 @@ std::vector<Eigen::Vector2d> convex_hull(std::vector<Eigen::Vector2d> pts) {
   return h;
 }
 
-// Distance from p to the hull (0 inside).
+// Distance from p to the hull (0 inside). The inside test comes first (it
+// needs no distances); outside, the smallest squared distance to an edge is
+// taken and its square root (the same value as the smallest root).
 double hull_distance(const std::vector<Eigen::Vector2d>& hull, const Eigen::Vector2d& p) {
   if (hull.size() == 1) return (p - hull[0]).norm();
-  bool inside = hull.size() >= 3;
+  const size_t n = hull.size();
+  if (n >= 3) {
+    bool inside = true;
+    for (size_t i = 0; i < n && inside; ++i) inside = cross2(hull[i], hull[(i + 1) % n], p) >= 0;
+    if (inside) return 0.0;
+  }
   double best = 1e300;
-  for (size_t i = 0; i < hull.size(); ++i) {
+  for (size_t i = 0; i < n; ++i) {
     const Eigen::Vector2d& a = hull[i];
-    const Eigen::Vector2d& b = hull[(i + 1) % hull.size()];
-    if (hull.size() >= 3 && cross2(a, b, p) < 0) inside = false;
+    const Eigen::Vector2d& b = hull[(i + 1) % n];
     const Eigen::Vector2d ab = b - a;
     const double t = std::clamp((p - a).dot(ab) / std::max(ab.squaredNorm(), 1e-300), 0.0, 1.0);
-    best = std::min(best, (a + t * ab - p).norm());
+    best = std::min(best, (a + t * ab - p).squaredNorm());
   }
-  return inside ? 0.0 : best;
+  return std::sqrt(best);
 }
 }  // namespace
 
