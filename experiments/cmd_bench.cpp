@@ -63,7 +63,7 @@ struct BenchFitArgs {
 // terms, 3 x N), the joint terms (P 2 x 4 row-major, res, reciprocal, the
 // projection mask res x res, 1 = texel in the mask, index j * res + i), the
 // options, and the fit's unknowns and rel_mse (exact_error as timed).
-void write_fit_input(const std::string& path, const BenchFitArgs& a, const FitData& d, const FitOptions& opt,
+void write_fit_input(std::ofstream& f, const std::string& path, const BenchFitArgs& a, const FitData& d, const FitOptions& opt,
                      const std::array<std::vector<double>, 3>& fixed_values, const std::vector<TermSpec>& joint,
                      const JointSolution& sol) {
   nlohmann::json j;
@@ -104,8 +104,6 @@ void write_fit_input(const std::string& path, const BenchFitArgs& a, const FitDa
   j["terms"] = terms;
   j["unknowns"] = sol.unknowns;
   j["rel_mse"] = sol.rel_mse;
-  std::ofstream f(path);
-  if (!f) throw std::runtime_error("--dump-input: cannot open '" + path + "' for writing");
   f << j.dump() << "\n";
   if (!f.flush()) throw std::runtime_error("--dump-input: writing '" + path + "' failed");
 }
@@ -136,6 +134,11 @@ void run_bench_fit(const BenchFitArgs& a) {
   else throw std::invalid_argument("--solver: expected auto, dense, sparse or qr, found '" + a.solver + "'");
   const Parameterization param = parse_parameterization(a.param);
   const FitData d(s, opt.eps);
+  std::ofstream dump;  // opened before the work, so that a bad path fails at once
+  if (!a.dump_input.empty()) {
+    dump.open(a.dump_input);
+    if (!dump) throw std::runtime_error("--dump-input: cannot open '" + a.dump_input + "' for writing");
+  }
 
   // Projections from seeded random rotations (what a search evaluates); the
   // terms before the joint block are fitted once, untimed.
@@ -203,7 +206,7 @@ void run_bench_fit(const BenchFitArgs& a) {
   j["threads"] = 1;
   j["kernel"] = kernels::active_variant();  // dense Cholesky variant (factor/dense_kernels.h)
   std::cout << j.dump() << std::endl;
-  if (!a.dump_input.empty()) write_fit_input(a.dump_input, a, d, opt, fixed_values, joint, sol);
+  if (!a.dump_input.empty()) write_fit_input(dump, a.dump_input, a, d, opt, fixed_values, joint, sol);
 }
 struct BenchSearchArgs {
   std::string brdf = "bluepaint";

@@ -66,3 +66,12 @@ def test_peer_refuses_what_it_does_not_implement(tmp_path):
     dump.write_text(json.dumps(j))
     with pytest.raises(peer["PeerError"], match=r"format: expected 'brdf-factor bench-fit input 1', found"):
         peer["load_input"](str(dump))
+
+
+def test_dump_input_refuses_a_path_it_cannot_write(tmp_path):
+    bad = tmp_path / "no such folder" / "input.json"
+    p = subprocess.run([cli_path(), "bench", "fit", "--grid", "4", "--texture", "4", "--repeats", "1",
+                        "--dump-input", str(bad)], capture_output=True, text=True)
+    assert p.returncode == 2
+    assert "--dump-input: cannot open '%s' for writing" % bad in p.stderr
+    assert p.stdout == ""  # refused before the benchmark ran
