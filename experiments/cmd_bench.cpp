@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <fstream>
 #include <iostream>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -52,7 +53,60 @@ struct BenchFitArgs {
   std::string solver = "auto";
   double smoothing = FitOptions{}.smoothing;
   bool exact_error = false;
+  std::string dump_input;  // --dump-input: the joint solve's input as JSON (write_fit_input)
 };
+
+// The joint solve's input and result as one JSON object, for an outside
+// implementation of the same fit (scripts/bench-peer.py, docs/speed.md "The
+// scipy peer"): the valid samples as the fit sees them (points x in the
+// terms' parameterization, N x 4 row-major; weights w; targets r = g - fixed
+// terms, 3 x N), the joint terms (P 2 x 4 row-major, res, reciprocal, the
+// projection mask res x res, 1 = texel in the mask, index j * res + i), the
+// options, and the fit's unknowns and rel_mse (exact_error as timed).
+void write_fit_input(std::ofstream& f, const std::string& path, const BenchFitArgs& a, const FitData& d, const FitOptions& opt,
+                     const std::array<std::vector<double>, 3>& fixed_values, const std::vector<TermSpec>& joint,
+                     const JointSolution& sol) {
+  nlohmann::json j;
+  j["format"] = "brdf-factor bench-fit input 1";
+  j["brdf"] = a.brdf;
+  j["grid"] = a.samples > 0 ? 0 : a.grid;
+  j["stratified_samples"] = a.samples;
+  j["parameterization"] = a.param;
+  j["smoothing"] = opt.smoothing;
+  j["extrapolation_prior"] = opt.extrapolation_prior;
+  j["solver"] = a.solver;
+  j["exact_error"] = a.exact_error;
+  j["samples"] = d.size();
+  j["W"] = d.W;
+  const std::vector<Vec4>& x = d.points(parse_parameterization(a.param));
+  std::vector<double> xs;
+  xs.reserve(4 * x.size());
+  for (const Vec4& p : x)
+    for (int c = 0; c < 4; ++c) xs.push_back(p[c]);
+  j["x"] = xs;
+  j["w"] = d.w;
+  nlohmann::json r = nlohmann::json::array();
+  for (int c = 0; c < 3; ++c) {
+    std::vector<double> rc(d.size());
+    for (size_t k = 0; k < d.size(); ++k) rc[k] = d.g[c][k] - fixed_values[c][k];
+    r.push_back(rc);
+  }
+  j["r"] = r;
+  nlohmann::json terms = nlohmann::json::array();
+  for (const TermSpec& t : joint) {
+    std::vector<double> P;
+    for (int row = 0; row < 2; ++row)
+      for (int col = 0; col < 4; ++col) P.push_back(t.proj.P(row, col));
+    const std::vector<uint8_t> m = projection_mask(t.proj);
+    terms.push_back({{"P", P}, {"res", t.proj.res}, {"reciprocal", t.reciprocal},
+                     {"mask", std::vector<int>(m.begin(), m.end())}});
+  }
+  j["terms"] = terms;
+  j["unknowns"] = sol.unknowns;
+  j["rel_mse"] = sol.rel_mse;
+  f << j.dump() << "\n";
+  if (!f.flush()) throw std::runtime_error("--dump-input: writing '" + path + "' failed");
+}
 
 void run_bench_fit(const BenchFitArgs& a) {
   if (a.repeats < 1) throw std::invalid_argument("--repeats: expected >= 1, found " + std::to_string(a.repeats));
@@ -80,6 +134,11 @@ void run_bench_fit(const BenchFitArgs& a) {
   else throw std::invalid_argument("--solver: expected auto, dense, sparse or qr, found '" + a.solver + "'");
   const Parameterization param = parse_parameterization(a.param);
   const FitData d(s, opt.eps);
+  std::ofstream dump;  // opened before the work, so that a bad path fails at once
+  if (!a.dump_input.empty()) {
+    dump.open(a.dump_input);
+    if (!dump) throw std::runtime_error("--dump-input: cannot open '" + a.dump_input + "' for writing");
+  }
 
   // Projections from seeded random rotations (what a search evaluates); the
   // terms before the joint block are fitted once, untimed.
@@ -147,6 +206,7 @@ void run_bench_fit(const BenchFitArgs& a) {
   j["threads"] = 1;
   j["kernel"] = kernels::active_variant();  // dense Cholesky variant (factor/dense_kernels.h)
   std::cout << j.dump() << std::endl;
+  if (!a.dump_input.empty()) write_fit_input(dump, a.dump_input, a, d, opt, fixed_values, joint, sol);
 }
 struct BenchSearchArgs {
   std::string brdf = "bluepaint";
@@ -533,6 +593,9 @@ void add_cmd_bench(CLI::App& app) {
   fit->add_flag("--exact-error", a->exact_error,
                 "score by a pass over the samples with the reconstruction's clamping (default: "
                 "the least-squares objective from the normal equations, as the search does)");
+  fit->add_option("--dump-input", a->dump_input,
+                  "also write the joint solve's input (samples, projections, masks) and its rel_mse as JSON "
+                  "to this file (scripts/bench-peer.py reads it)");
   fit->callback([a] { run_bench_fit(*a); });
 
   auto* search = bench->add_subcommand("search", "Time the greedy projection search (all cores)");

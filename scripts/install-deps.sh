@@ -28,6 +28,7 @@ PACKAGES=(
   pybind11-dev           # the Python module (python/), built for /usr/bin/python3
   python3-dev            # Python headers and libpython for the module
   python3-numpy          # arrays in and out of the Python module
+  python3-scipy          # the scipy peer of `bench fit` (scripts/bench-peer.py, docs/speed.md)
   python3-pytest         # the Python module's tests (python/tests/)
   python3-pip python3-setuptools python3-wheel python3-venv  # `pip install .` of the module (docs/python.md)
   git                    # the build's commit in run records (a runner test needs it)
