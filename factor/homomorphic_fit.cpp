@@ -563,6 +563,187 @@ void add_prior_dense(const Prior& p, Eigen::Ref<Eigen::MatrixXd> A, Eigen::Matri
   }
 }
 
+// ---- Sparse path: the normal matrix assembled directly (no B, no sparse product).
+
+using SparseLower = Eigen::SparseMatrix<double>;  // column-major, int indices
+
+// Buffers of the sparse assembly, one set per thread, reused across fits (the
+// dense path has its own Workspace). Nothing is carried from one fit to the next.
+struct SparseWorkspace {
+  std::vector<Eigen::Triplet<double>> trip;  // (row >= col) contributions to A
+  std::vector<CellAcc> cells;                // per-cell self sums of one lookup
+  std::vector<int> count, order;             // samples bucketed by their cell (cross blocks)
+  std::vector<int> slot;                     // per cell of the later lookup: block slot or -1
+  std::vector<int> slot_cell;                // per block slot: the later lookup's cell
+  std::vector<double> blk;                   // per block slot: 16 sums
+  std::array<std::vector<double>, 3> r;      // residual targets g - fixed, per channel
+};
+
+SparseWorkspace& sparse_workspace() {
+  thread_local SparseWorkspace ws;
+  return ws;
+}
+
+// The sparse path's normal equations A y = rhs without the gauge and ridge:
+// A (M x M, lower triangle only, compressed, every diagonal entry stored) =
+// B^T W B of the sample rows + mu L^T L + the prior's rows, rhs = B^T W r + the
+// prior's targets, with r the residual targets g - fixed per channel. Equal to
+// (B^T B) of the stacked rows of the earlier implementation up to summation
+// order.
+//  - each lookup's self-products are summed per bilinear cell (CellAcc, 10
+//    sums and 4x3 right-hand side sums) and emitted once per cell;
+//  - each pair of lookups (p earlier than q): samples bucketed by p's cell,
+//    within a bucket the 4x4 products summed per q cell (a slot table over q's
+//    cells), emitted once per (p cell, q cell) pair. A reciprocal term's
+//    projection/conjugate pair lands in its own diagonal block: each product
+//    goes to (max, min) and the diagonal takes it twice (b b^T holds
+//    s_p s_q^T + s_q s_p^T).
+void assemble_sparse(const FitData& d, const std::array<const double*, 3>& r,
+                     const std::vector<TermLayout>& terms,
+                     const std::vector<const std::array<Lookups, 2>*>& lookups, double mu,
+                     const Prior& prior, int M, SparseLower& A, Eigen::MatrixXd& rhs) {
+  const size_t N = d.size();
+  const double* w = d.w.data();
+  SparseWorkspace& ws = sparse_workspace();
+  std::vector<Eigen::Triplet<double>>& trip = ws.trip;
+  trip.clear();
+  rhs.setZero(M, 3);
+  for (int i = 0; i < M; ++i) trip.emplace_back(i, i, 0.0);  // every diagonal entry stored
+  struct Sub {
+    const TermLayout* t;
+    const Lookups* lk;
+  };
+  std::vector<Sub> subs;
+  for (size_t ti = 0; ti < terms.size(); ++ti)
+    for (int h = 0; h < (terms[ti].reciprocal ? 2 : 1); ++h) subs.push_back({&terms[ti], &(*lookups[ti])[h]});
+  const auto push = [&trip](int i, int j, double v) {
+    if (i >= j) trip.emplace_back(i, j, v);
+    else trip.emplace_back(j, i, v);
+  };
+
+  // Self-products, per cell.
+  for (const Sub& s : subs) {
+    const TermLayout& t = *s.t;
+    const int R = t.proj.res;
+    ws.cells.assign(size_t(R) * R, CellAcc{});
+    CellAcc* cells = ws.cells.data();
+    const int* cell = s.lk->cell.data();
+    const double* fa = s.lk->fa.data();
+    const double* fb = s.lk->fb.data();
+    const double* r0 = r[0];
+    const double* r1 = r[1];
+    const double* r2 = r[2];
+    for (size_t k = 0; k < N; ++k) {
+      const double a = fa[k], b = fb[k], wk = w[k];
+      const double b0 = (1 - a) * (1 - b), b1 = a * (1 - b), b2 = (1 - a) * b, b3 = a * b;
+      CellAcc& acc = cells[cell[k]];
+      const double wb0 = wk * b0, wb1 = wk * b1, wb2 = wk * b2, wb3 = wk * b3;
+      acc.q[0] += wb0 * b0; acc.q[1] += wb1 * b0; acc.q[2] += wb2 * b0; acc.q[3] += wb3 * b0;
+      acc.q[4] += wb1 * b1; acc.q[5] += wb2 * b1; acc.q[6] += wb3 * b1;
+      acc.q[7] += wb2 * b2; acc.q[8] += wb3 * b2; acc.q[9] += wb3 * b3;
+      const double rk[3] = {r0[k], r1[k], r2[k]};
+      for (int c = 0; c < 3; ++c) {
+        acc.r[0][c] += wb0 * rk[c]; acc.r[1][c] += wb1 * rk[c];
+        acc.r[2][c] += wb2 * rk[c]; acc.r[3][c] += wb3 * rk[c];
+      }
+    }
+    static constexpr int pairs[10][2] = {{0, 0}, {1, 0}, {2, 0}, {3, 0}, {1, 1},
+                                         {2, 1}, {3, 1}, {2, 2}, {3, 2}, {3, 3}};
+    for (size_t c0 = 0; c0 < ws.cells.size(); ++c0) {
+      const CellAcc& acc = cells[c0];
+      if (acc.q[0] == 0 && acc.q[4] == 0 && acc.q[7] == 0 && acc.q[9] == 0) continue;
+      const int id[4] = {t.unk[c0], t.unk[c0 + 1], t.unk[c0 + R], t.unk[c0 + R + 1]};
+      for (int e = 0; e < 10; ++e) push(id[pairs[e][0]], id[pairs[e][1]], acc.q[e]);
+      for (int v = 0; v < 4; ++v)
+        for (int c = 0; c < 3; ++c) rhs(id[v], c) += acc.r[v][c];
+    }
+  }
+
+  // Cross products of different lookups, per (p cell, q cell) pair.
+  for (size_t p = 0; p < subs.size(); ++p)
+    for (size_t q = p + 1; q < subs.size(); ++q) {
+      const TermLayout& tp = *subs[p].t;
+      const TermLayout& tq = *subs[q].t;
+      const Lookups& lp = *subs[p].lk;
+      const Lookups& lq = *subs[q].lk;
+      const bool same = &tp == &tq;
+      const int Rp = tp.proj.res, Rq = tq.proj.res;
+      // Samples bucketed by p's cell (counting sort, sample order kept).
+      ws.count.assign(size_t(Rp) * Rp + 1, 0);
+      for (size_t k = 0; k < N; ++k) ++ws.count[lp.cell[k] + 1];
+      for (size_t c = 1; c < ws.count.size(); ++c) ws.count[c] += ws.count[c - 1];
+      ws.order.resize(N);
+      for (size_t k = 0; k < N; ++k) ws.order[ws.count[lp.cell[k]]++] = static_cast<int>(k);
+      // count[c] is now the end of bucket c (and the start of bucket c + 1).
+      ws.slot.assign(size_t(Rq) * Rq, -1);
+      size_t begin = 0;
+      for (int cp = 0; cp < Rp * Rp; ++cp) {
+        const size_t end = static_cast<size_t>(ws.count[cp]);
+        if (end == begin) continue;
+        int nslot = 0;
+        for (size_t e = begin; e < end; ++e) {
+          const int k = ws.order[e];
+          const int cq = lq.cell[k];
+          int sl = ws.slot[cq];
+          if (sl < 0) {
+            sl = ws.slot[cq] = nslot++;
+            if (ws.slot_cell.size() < size_t(nslot)) ws.slot_cell.resize(nslot);
+            if (ws.blk.size() < 16 * size_t(nslot)) ws.blk.resize(16 * size_t(nslot));
+            ws.slot_cell[sl] = cq;
+            std::fill_n(ws.blk.data() + 16 * size_t(sl), 16, 0.0);
+          }
+          const double a = lp.fa[k], b = lp.fb[k], wk = w[k];
+          const double sp[4] = {wk * ((1 - a) * (1 - b)), wk * (a * (1 - b)), wk * ((1 - a) * b), wk * (a * b)};
+          const double c2 = lq.fa[k], d2 = lq.fb[k];
+          const double sq[4] = {(1 - c2) * (1 - d2), c2 * (1 - d2), (1 - c2) * d2, c2 * d2};
+          double* bk = ws.blk.data() + 16 * size_t(sl);
+          for (int a2 = 0; a2 < 4; ++a2)
+            for (int b2 = 0; b2 < 4; ++b2) bk[4 * a2 + b2] += sp[a2] * sq[b2];
+        }
+        const int ip[4] = {tp.unk[cp], tp.unk[cp + 1], tp.unk[cp + Rp], tp.unk[cp + Rp + 1]};
+        for (int sl = 0; sl < nslot; ++sl) {
+          const int cq = ws.slot_cell[sl];
+          ws.slot[cq] = -1;
+          const int iq[4] = {tq.unk[cq], tq.unk[cq + 1], tq.unk[cq + Rq], tq.unk[cq + Rq + 1]};
+          const double* bk = ws.blk.data() + 16 * size_t(sl);
+          for (int a2 = 0; a2 < 4; ++a2)
+            for (int b2 = 0; b2 < 4; ++b2) {
+              const double v = bk[4 * a2 + b2];
+              if (same && ip[a2] == iq[b2]) push(ip[a2], ip[a2], 2.0 * v);
+              else push(iq[b2], ip[a2], v);
+            }
+        }
+        begin = end;
+      }
+    }
+
+  // Laplacian rows, mu L^T L.
+  for (const TermLayout& t : terms)
+    laplacian_rows(t, [&](const int* li, const double* lv, int n) {
+      for (int a = 0; a < n; ++a)
+        for (int b = 0; b < n; ++b)
+          if (li[a] >= li[b]) trip.emplace_back(li[a], li[b], mu * lv[a] * lv[b]);
+    });
+  // The prior (as add_prior_dense).
+  for (const Prior::Level& lv : prior.levels)  // Lambda - lambda lambda^T / sum(lambda)
+    for (size_t a = 0; a < lv.idx.size(); ++a)
+      for (size_t b = 0; b < lv.idx.size(); ++b)
+        if (lv.idx[a] >= lv.idx[b])
+          trip.emplace_back(lv.idx[a], lv.idx[b], (a == b ? lv.w[a] : 0.0) - lv.w[a] * lv.w[b] / lv.sum);
+  for (size_t pr = 0; pr < prior.rows(); ++pr) {
+    const double pw = prior.w[pr];
+    for (int a = prior.start[pr]; a < prior.start[pr + 1]; ++a) {
+      for (int b = prior.start[pr]; b < prior.start[pr + 1]; ++b)
+        if (prior.idx[a] >= prior.idx[b])
+          trip.emplace_back(prior.idx[a], prior.idx[b], pw * prior.val[a] * prior.val[b]);
+      for (int c = 0; c < 3; ++c) rhs(prior.idx[a], c) += pw * prior.val[a] * prior.target[pr][c];
+    }
+  }
+  A.resize(M, M);
+  A.setFromTriplets(trip.begin(), trip.end());
+  if (trip.capacity() > (size_t(4) << 20)) std::vector<Eigen::Triplet<double>>().swap(trip);
+}
+
 }  // namespace
 
 struct JointPrefix::Impl {
@@ -669,49 +850,21 @@ JointSolution solve_joint(const FitData& d, const std::array<std::vector<double>
     solver = M <= 1500 ? FitOptions::Solver::Dense : FitOptions::Solver::Sparse;
 
   if (solver == FitOptions::Solver::Sparse) {
-    using SpMat = Eigen::SparseMatrix<double>;
-    std::vector<Eigen::Triplet<double>> trip;
-    trip.reserve(N * maxL);
-    Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(M, 3);
-    for (size_t k = 0; k < N; ++k) {
-      const int L = stencil(k, idx.data(), val.data());
-      const double sw = std::sqrt(d.w[k]);
-      const double r0 = d.g[0][k] - fixed_values[0][k];
-      const double r1 = d.g[1][k] - fixed_values[1][k];
-      const double r2 = d.g[2][k] - fixed_values[2][k];
-      for (int a = 0; a < L; ++a) {
-        trip.emplace_back(static_cast<int>(k), idx[a], sw * val[a]);
-        const double wa = d.w[k] * val[a];
-        rhs(idx[a], 0) += wa * r0;
-        rhs(idx[a], 1) += wa * r1;
-        rhs(idx[a], 2) += wa * r2;
+    using SpMat = SparseLower;
+    std::array<const double*, 3> r;
+    if (K > 0) {
+      for (int c = 0; c < 3; ++c) r[c] = prefix->impl().r[c].data();
+    } else {
+      std::array<std::vector<double>, 3>& rr = sparse_workspace().r;
+      for (int c = 0; c < 3; ++c) {
+        rr[c].resize(N);
+        for (size_t k = 0; k < N; ++k) rr[c][k] = d.g[c][k] - fixed_values[c][k];
+        r[c] = rr[c].data();
       }
     }
-    int row = static_cast<int>(N);
-    const double smu = std::sqrt(mu);
-    for (const TermLayout& t : terms)
-      laplacian_rows(t, [&](const int* li, const double* lv, int n) {
-        for (int a = 0; a < n; ++a) trip.emplace_back(row, li[a], smu * lv[a]);
-        ++row;
-      });
-    for (size_t pr = 0; pr < prior.rows(); ++pr, ++row) {
-      const double sw = std::sqrt(prior.w[pr]);
-      for (int e = prior.start[pr]; e < prior.start[pr + 1]; ++e) {
-        trip.emplace_back(row, prior.idx[e], sw * prior.val[e]);
-        for (int c = 0; c < 3; ++c) rhs(prior.idx[e], c) += prior.w[pr] * prior.val[e] * prior.target[pr][c];
-      }
-    }
-    for (const Prior::Level& lv : prior.levels)  // rows sqrt(w_i) (e_i - w / sum)
-      for (size_t a = 0; a < lv.idx.size(); ++a, ++row) {
-        const double sw = std::sqrt(lv.w[a]);
-        for (size_t b = 0; b < lv.idx.size(); ++b)
-          trip.emplace_back(row, lv.idx[b], sw * ((a == b ? 1.0 : 0.0) - lv.w[b] / lv.sum));
-      }
-    SpMat B(row, M);
-    B.setFromTriplets(trip.begin(), trip.end());
-    trip.clear();
-    trip.shrink_to_fit();
-    SpMat A = (B.transpose() * B).pruned();
+    SpMat A;
+    Eigen::MatrixXd rhs;
+    assemble_sparse(d, r, terms, lookups, mu, prior, M, A, rhs);
     double mean_diag = A.diagonal().sum() / std::max(M, 1);
     // Gauge as a soft constraint on each later term's texel mean would make the
     // matrix dense in that block; in the sparse path we pin one texel of each
