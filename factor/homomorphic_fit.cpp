@@ -10,6 +10,7 @@
 #include <Eigen/SparseCore>
 #ifdef BF_FACTOR_CHOLMOD
 #include <Eigen/CholmodSupport>
+#include <dlfcn.h>
 #endif
 #include <algorithm>
 #include <cmath>
@@ -744,6 +745,21 @@ void assemble_sparse(const FitData& d, const std::array<const double*, 3>& r,
   if (trip.capacity() > (size_t(4) << 20)) std::vector<Eigen::Triplet<double>>().swap(trip);
 }
 
+#ifdef BF_FACTOR_CHOLMOD
+// CHOLMOD's supernodal factorization opens OpenMP parallel regions (Debian's
+// build asks for 4 threads in its larger supernodes). The fits already run one
+// per thread (bench, search restarts), so nested threads only add wake-ups and
+// task switches (10-15% of a texture-64 fit). OpenMP's max-active-levels = 0
+// makes every parallel region run on the thread that meets it. The setter is
+// looked up at run time in the OpenMP runtime CHOLMOD loaded (nothing else in
+// the project uses OpenMP), so the library does not link one itself.
+void cholmod_serial_openmp() {
+  using Setter = void (*)(int);
+  static const Setter set = reinterpret_cast<Setter>(dlsym(RTLD_DEFAULT, "omp_set_max_active_levels"));
+  if (set) set(0);
+}
+#endif
+
 }  // namespace
 
 struct JointPrefix::Impl {
@@ -877,7 +893,21 @@ JointSolution solve_joint(const FitData& d, const std::array<std::vector<double>
 #ifdef BF_FACTOR_CHOLMOD
     // SuiteSparse's supernodal Cholesky (dense BLAS blocks on the supernodes):
     // several times faster than the simplicial LLT at texture 64 (docs/speed.md).
-    Eigen::CholmodSupernodalLLT<SpMat, Eigen::Lower> llt(A);
+    // SuiteSparse's supernodal Cholesky (dense BLAS blocks on the supernodes),
+    // with AMD as the only ordering (CHOLMOD's default also tries METIS on
+    // larger matrices: AMD gives less fill here and costs less, docs/speed.md)
+    // and CHOLMOD's OpenMP regions serial (see cholmod_serial_openmp).
+    cholmod_serial_openmp();
+    Eigen::CholmodSupernodalLLT<SpMat, Eigen::Lower> llt;
+    cholmod_common& cc = llt.cholmod();
+    cc.nmethods = 1;
+    cc.method[0].ordering = CHOLMOD_AMD;
+    cc.postorder = 1;
+    cc.print = 0;  // no CHOLMOD messages on stdout: failures are thrown below
+    llt.compute(A);
+    if (cc.status < 0)
+      throw std::runtime_error("fit: CHOLMOD failed with status " + std::to_string(cc.status) + " (" +
+                               std::to_string(M) + " unknowns)");
 #else
     Eigen::SimplicialLLT<SpMat, Eigen::Lower, Eigen::AMDOrdering<int>> llt(A);
 #endif
