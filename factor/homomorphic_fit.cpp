@@ -586,7 +586,8 @@ SparseWorkspace& sparse_workspace() {
 }
 
 // The sparse path's normal equations A y = rhs without the gauge and ridge:
-// A (M x M, lower triangle only, compressed, every diagonal entry stored) =
+// A (M x M, lower triangle only, compressed with sorted rows, every diagonal
+// entry stored, hence first in its column) =
 // B^T W B of the sample rows + mu L^T L + the prior's rows, rhs = B^T W r + the
 // prior's targets, with r the residual targets g - fixed per channel. Equal to
 // (B^T B) of the stacked rows of the earlier implementation up to summation
@@ -881,18 +882,17 @@ JointSolution solve_joint(const FitData& d, const std::array<std::vector<double>
     SpMat A;
     Eigen::MatrixXd rhs;
     assemble_sparse(d, r, terms, lookups, mu, prior, M, A, rhs);
-    double mean_diag = A.diagonal().sum() / std::max(M, 1);
+    // Each column's diagonal entry is its first (assemble_sparse).
+    const auto diag = [&A](int i) -> double& { return A.valuePtr()[A.outerIndexPtr()[i]]; };
+    double mean_diag = 0;
+    for (int i = 0; i < M; ++i) mean_diag += diag(i);
+    mean_diag /= std::max(M, 1);
     // Gauge as a soft constraint on each later term's texel mean would make the
     // matrix dense in that block; in the sparse path we pin one texel of each
     // later joint term instead (same effect: removes the constant freedom).
-    for (size_t t = 1; t < terms.size(); ++t) {
-      const int i0 = terms[t].first;
-      A.coeffRef(i0, i0) += mean_diag;
-    }
-    for (int i = 0; i < M; ++i) A.coeffRef(i, i) += 1e-12 * mean_diag + std::numeric_limits<double>::min();
+    for (size_t t = 1; t < terms.size(); ++t) diag(terms[t].first) += mean_diag;
+    for (int i = 0; i < M; ++i) diag(i) += 1e-12 * mean_diag + std::numeric_limits<double>::min();
 #ifdef BF_FACTOR_CHOLMOD
-    // SuiteSparse's supernodal Cholesky (dense BLAS blocks on the supernodes):
-    // several times faster than the simplicial LLT at texture 64 (docs/speed.md).
     // SuiteSparse's supernodal Cholesky (dense BLAS blocks on the supernodes),
     // with AMD as the only ordering (CHOLMOD's default also tries METIS on
     // larger matrices: AMD gives less fill here and costs less, docs/speed.md)
