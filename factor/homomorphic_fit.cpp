@@ -858,7 +858,7 @@ JointSolution solve_joint(const FitData& d, const std::array<std::vector<double>
   const double mu = opt.smoothing * d.W / std::max(M, 1);
   const Prior prior = extrapolation_prior(d, fixed_values, terms, lookups, M, opt);
   Eigen::MatrixXd Y(M, 3);  // solution, one column per channel
-  double quad_rel_mse = -1;  // set by the dense path when !exact_error
+  double quad_rel_mse = -1;  // set by the dense and sparse paths when !exact_error
   std::vector<int> idx(maxL);
   std::vector<double> val(maxL);
 
@@ -891,7 +891,8 @@ JointSolution solve_joint(const FitData& d, const std::array<std::vector<double>
     // matrix dense in that block; in the sparse path we pin one texel of each
     // later joint term instead (same effect: removes the constant freedom).
     for (size_t t = 1; t < terms.size(); ++t) diag(terms[t].first) += mean_diag;
-    for (int i = 0; i < M; ++i) diag(i) += 1e-12 * mean_diag + std::numeric_limits<double>::min();
+    const double reg_diag = 1e-12 * mean_diag + std::numeric_limits<double>::min();
+    for (int i = 0; i < M; ++i) diag(i) += reg_diag;
 #ifdef BF_FACTOR_CHOLMOD
     // SuiteSparse's supernodal Cholesky (dense BLAS blocks on the supernodes),
     // with AMD as the only ordering (CHOLMOD's default also tries METIS on
@@ -915,6 +916,36 @@ JointSolution solve_joint(const FitData& d, const std::array<std::vector<double>
       throw std::runtime_error("fit: the normal matrix is not positive definite (" +
                                std::to_string(M) + " unknowns)");
     Y = llt.solve(rhs);
+    if (!exact_error) {
+      // As the dense path: at the solution A y = rhs, so the data residual is
+      // sum w r^2 - y.rhs - (regularization quadratic form at y); the gauge
+      // here is the pinned texels' mean_diag y_i0^2.
+      double sum_wr2[3] = {0, 0, 0};
+      if (K > 0) {
+        for (int c = 0; c < 3; ++c) sum_wr2[c] = prefix->impl().sum_wr2[c];
+      } else {
+        for (size_t k = 0; k < N; ++k)
+          for (int c = 0; c < 3; ++c) sum_wr2[c] += d.w[k] * r[c][k] * r[c][k];
+      }
+      double se = 0;
+      for (int c = 0; c < 3; ++c) {
+        double reg = reg_diag * Y.col(c).squaredNorm();
+        for (const TermLayout& t : terms)
+          laplacian_rows(t, [&](const int* li, const double* lv, int n) {
+            double v = 0;
+            for (int a2 = 0; a2 < n; ++a2) v += lv[a2] * Y(li[a2], c);
+            reg += mu * v * v;
+          });
+        for (size_t t = 1; t < terms.size(); ++t) reg += mean_diag * Y(terms[t].first, c) * Y(terms[t].first, c);
+        for (size_t pr = 0; pr < prior.rows(); ++pr) {
+          const double by = prior.dot(pr, Y, c);
+          reg += prior.w[pr] * by * (by - 2.0 * prior.target[pr][c]);
+        }
+        for (const Prior::Level& lv : prior.levels) reg += lv.energy(Y, c);
+        se += sum_wr2[c] - Y.col(c).dot(rhs.col(c)) - reg;
+      }
+      quad_rel_mse = std::max(0.0, se) / (3.0 * d.W);
+    }
   } else if (solver == FitOptions::Solver::Dense) {
     // The normal matrix lives in the thread's workspace (no allocation once it
     // has grown); only its lower triangle is cleared, filled and factored.

@@ -76,6 +76,21 @@ TEST_CASE("sparse fit: equals the dense and reference QR paths on a planted reci
       CHECK(rel_diff(sol[0].rel_mse, sol[2].rel_mse) < 1e-8);
       CHECK(to_dense < 2e-6);
       CHECK(to_qr < 2e-6);
+      // The search's objective (exact_error = false), read off the normal
+      // equations by both Cholesky paths, against the unclamped residual.
+      opt.solver = FitOptions::Solver::Sparse;
+      const double quad_sparse = solve_joint(d, zero, joint, opt, false).rel_mse;
+      opt.solver = FitOptions::Solver::Dense;
+      const double quad_dense = solve_joint(d, zero, joint, opt, false).rel_mse;
+      double se = 0;
+      const auto fit = fixed_sum(d, sol[2].terms);
+      for (int c = 0; c < 3; ++c)
+        for (size_t k = 0; k < d.size(); ++k) se += d.w[k] * (fit[c][k] - d.g[c][k]) * (fit[c][k] - d.g[c][k]);
+      const double direct = se / (3.0 * d.W);
+      INFO("objective: sparse " << quad_sparse << ", dense " << quad_dense << ", direct (QR, float texels) "
+                                << direct);
+      CHECK(rel_diff(quad_sparse, quad_dense) < 1e-7);
+      CHECK(rel_diff(quad_sparse, direct) < 1e-4);
     }
   }
 }
@@ -98,6 +113,10 @@ TEST_CASE("sparse fit: a JointPrefix and residual targets give the same solution
   const JointPrefix prefix(d, fixed, {joint[0]}, opt);
   const JointSolution pre = solve_joint(d, fixed, joint, opt, true, &prefix);
   CHECK(rel_diff(pre.rel_mse, plain.rel_mse) < 1e-12);
+  // The search's objective (exact_error = false) with the prefix's sum w r^2.
+  const double quad_plain = solve_joint(d, fixed, joint, opt, false).rel_mse;
+  const double quad_pre = solve_joint(d, fixed, joint, opt, false, &prefix).rel_mse;
+  CHECK(rel_diff(quad_pre, quad_plain) < 1e-12);
   opt.solver = FitOptions::Solver::ReferenceQR;
   const JointSolution ref = solve_joint(d, fixed, joint, opt);
   CHECK(rel_diff(plain.rel_mse, ref.rel_mse) < 1e-8);
