@@ -884,8 +884,12 @@ JointSolution solve_joint(const FitData& d, const std::array<std::vector<double>
   std::vector<double> val(maxL);
 
   FitOptions::Solver solver = opt.solver;
+  // Auto: dense up to 900 unknowns, or up to 1,300 with 500,000 samples or
+  // more (the sparse assembly costs more per sample); measured crossovers
+  // (docs/speed.md, "Sparse path"): 43,264 samples between 870 and 946
+  // unknowns, 1M samples about 1,270.
   if (solver == FitOptions::Solver::Auto)
-    solver = M <= 1500 ? FitOptions::Solver::Dense : FitOptions::Solver::Sparse;
+    solver = M <= (N >= 500000 ? 1300 : 900) ? FitOptions::Solver::Dense : FitOptions::Solver::Sparse;
 
   if (solver == FitOptions::Solver::Sparse) {
     using SpMat = SparseLower;
