@@ -36,7 +36,9 @@ double worst_function_difference(const FitData& d, const JointSolution& a, const
 }
 
 // |a - b| / |b| (b != 0).
-double rel_diff(double a, double b) { return std::abs(a - b) / std::abs(b); }
+double rel_diff(double a, double b) {
+  return std::abs(a - b) / std::abs(b);
+}
 
 }  // namespace
 
@@ -64,11 +66,13 @@ TEST_CASE("sparse fit: equals the dense and reference QR paths on a planted reci
       const double to_dense = worst_function_difference(d, sol[0], sol[1]);
       const double to_qr = worst_function_difference(d, sol[0], sol[2]);
       INFO((planted ? "McCool terms" : "rotated terms")
-           << ", prior " << prior << ": rel_mse sparse " << sol[0].rel_mse << ", relative difference to dense "
-           << rel_diff(sol[0].rel_mse, sol[1].rel_mse) << ", to QR " << rel_diff(sol[0].rel_mse, sol[2].rel_mse)
+           << ", prior " << prior << ": rel_mse sparse " << sol[0].rel_mse
+           << ", relative difference to dense " << rel_diff(sol[0].rel_mse, sol[1].rel_mse)
+           << ", to QR " << rel_diff(sol[0].rel_mse, sol[2].rel_mse)
            << "; worst log difference to dense " << to_dense << ", to QR " << to_qr);
       REQUIRE(sol[0].unknowns == sol[1].unknowns);
-      if (planted && prior == 0.0) CHECK(sol[0].rel_mse < 1e-3);  // bilinear interpolation error only
+      if (planted && prior == 0.0)
+        CHECK(sol[0].rel_mse < 1e-3);  // bilinear interpolation error only
       // The same least-squares problem: equal residuals (the residual is
       // computed in double from the solution), and the same function up to
       // the float texels (about 1e-7 relative to log values of order 1).
@@ -85,17 +89,19 @@ TEST_CASE("sparse fit: equals the dense and reference QR paths on a planted reci
       double se = 0;
       const auto fit = fixed_sum(d, sol[2].terms);
       for (int c = 0; c < 3; ++c)
-        for (size_t k = 0; k < d.size(); ++k) se += d.w[k] * (fit[c][k] - d.g[c][k]) * (fit[c][k] - d.g[c][k]);
+        for (size_t k = 0; k < d.size(); ++k)
+          se += d.w[k] * (fit[c][k] - d.g[c][k]) * (fit[c][k] - d.g[c][k]);
       const double direct = se / (3.0 * d.W);
-      INFO("objective: sparse " << quad_sparse << ", dense " << quad_dense << ", direct (QR, float texels) "
-                                << direct);
+      INFO("objective: sparse " << quad_sparse << ", dense " << quad_dense
+                                << ", direct (QR, float texels) " << direct);
       CHECK(rel_diff(quad_sparse, quad_dense) < 1e-7);
       CHECK(rel_diff(quad_sparse, direct) < 1e-4);
     }
   }
 }
 
-TEST_CASE("sparse fit: a JointPrefix and residual targets give the same solution as a plain solve") {
+TEST_CASE(
+    "sparse fit: a JointPrefix and residual targets give the same solution as a plain solve") {
   const bf_test::McCoolFormBrdf brdf;
   const SampleSet s = sample_stratified(brdf, 2000, 37);
   std::mt19937_64 rng(41);
