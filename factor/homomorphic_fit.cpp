@@ -581,7 +581,9 @@ struct SparseWorkspace {
   std::vector<Eigen::Triplet<double>> trip;  // (row <= col) contributions to A
   std::vector<CellAcc> cells;                // per-cell self sums of one lookup
   std::vector<int> count;                    // per cell of the earlier lookup: bucket end
-  std::vector<SampleRec> rec;                // samples' data, bucketed by that cell
+  std::vector<SampleRec> rec;                // samples' data, bucketed by that cell (48 bytes per
+                                             // sample, kept across fits so that a search's
+                                             // fits do not allocate it again)
   std::vector<int> slot;                     // per cell of the later lookup: block slot or -1
   std::vector<int> slot_cell;                // per block slot: the later lookup's cell
   std::vector<double> blk;                   // per block slot: 16 sums
