@@ -11,6 +11,7 @@
 #include <Eigen/SparseCore>
 #ifdef BF_FACTOR_CHOLMOD
 #include <Eigen/CholmodSupport>
+#include <dlfcn.h>
 #endif
 #include <algorithm>
 #include <cmath>
@@ -510,6 +511,208 @@ void add_prior_dense(const Prior& p, Eigen::Ref<Eigen::MatrixXd> A, Eigen::Matri
   }
 }
 
+// ---- Sparse path: the normal matrix assembled directly (no B, no sparse product).
+
+using SparseUpper = Eigen::SparseMatrix<double>;  // column-major, int indices
+
+// One sample's data for the cross products of two lookups p and q: p's and
+// q's cell fractions, its weight and q's cell.
+struct SampleRec {
+  double pa, pb, qa, qb, w;
+  int cq;
+};
+
+// Buffers of the sparse assembly, one set per thread, reused across fits (the
+// dense path has its own Workspace). Nothing is carried from one fit to the next.
+struct SparseWorkspace {
+  std::vector<Eigen::Triplet<double>> trip;  // (row <= col) contributions to A
+  std::vector<double> cells;                 // per-cell self sums of one lookup (kernels::cell_sums)
+  std::vector<int> count;                    // per cell of the earlier lookup: bucket end
+  std::vector<SampleRec> rec;                // samples' data, bucketed by that cell (48 bytes per
+                                             // sample, kept across fits so that a search's
+                                             // fits do not allocate it again)
+  std::vector<int> slot;                     // per cell of the later lookup: block slot or -1
+  std::vector<int> slot_cell;                // per block slot: the later lookup's cell
+  std::vector<double> blk;                   // per block slot: 16 sums
+  std::array<std::vector<double>, 3> r;      // residual targets g - fixed, per channel
+};
+
+SparseWorkspace& sparse_workspace() {
+  thread_local SparseWorkspace ws;
+  return ws;
+}
+
+// The sparse path's normal equations A y = rhs without the gauge and ridge:
+// A (M x M, upper triangle only, compressed with sorted rows, every diagonal
+// entry stored, hence last in its column; with CHOLMOD about 4% faster than
+// the lower triangle at texture 32) =
+// B^T W B of the sample rows + mu L^T L + the prior's rows, rhs = B^T W r + the
+// prior's targets, with r the residual targets g - fixed per channel. Equal to
+// (B^T B) of the stacked rows of the earlier implementation up to summation
+// order.
+//  - each lookup's self-products are summed per bilinear cell (kernels::cell_sums, 10
+//    sums and 4x3 right-hand side sums) and emitted once per cell;
+//  - each pair of lookups (p earlier than q): samples bucketed by p's cell,
+//    within a bucket the 4x4 products summed per q cell (a slot table over q's
+//    cells), emitted once per (p cell, q cell) pair. A reciprocal term's
+//    projection/conjugate pair lands in its own diagonal block: each product
+//    goes to (min, max) and the diagonal takes it twice (b b^T holds
+//    s_p s_q^T + s_q s_p^T).
+void assemble_sparse(const FitData& d, const std::array<const double*, 3>& r,
+                     const std::vector<TermLayout>& terms,
+                     const std::vector<const std::array<Lookups, 2>*>& lookups, double mu,
+                     const Prior& prior, int M, SparseUpper& A, Eigen::MatrixXd& rhs) {
+  const size_t N = d.size();
+  const double* w = d.w.data();
+  SparseWorkspace& ws = sparse_workspace();
+  std::vector<Eigen::Triplet<double>>& trip = ws.trip;
+  trip.clear();
+  rhs.setZero(M, 3);
+  for (int i = 0; i < M; ++i) trip.emplace_back(i, i, 0.0);  // every diagonal entry stored
+  struct Sub {
+    const TermLayout* t;
+    const Lookups* lk;
+  };
+  std::vector<Sub> subs;
+  for (size_t ti = 0; ti < terms.size(); ++ti)
+    for (int h = 0; h < (terms[ti].reciprocal ? 2 : 1); ++h) subs.push_back({&terms[ti], &(*lookups[ti])[h]});
+  const auto push = [&trip](int i, int j, double v) {
+    if (i >= j) trip.emplace_back(j, i, v);
+    else trip.emplace_back(i, j, v);
+  };
+
+  // Self-products, per cell.
+  for (const Sub& s : subs) {
+    const TermLayout& t = *s.t;
+    const int R = t.proj.res;
+    ws.cells.assign(size_t(R) * R * kernels::kCellDoubles, 0.0);
+    kernels::cell_sums(N, s.lk->cell.data(), s.lk->fa.data(), s.lk->fb.data(), w, r[0], r[1], r[2],
+                       ws.cells.data());
+    static constexpr int pairs[10][2] = {{0, 0}, {1, 0}, {2, 0}, {3, 0}, {1, 1},
+                                         {2, 1}, {3, 1}, {2, 2}, {3, 2}, {3, 3}};
+    for (size_t c0 = 0; c0 < size_t(R) * R; ++c0) {
+      const double* acc = ws.cells.data() + c0 * kernels::kCellDoubles;  // Q (i, j) at 4 j + i, R at 16 + 4 c + v
+      if (acc[0] == 0 && acc[5] == 0 && acc[10] == 0 && acc[15] == 0) continue;
+      const int id[4] = {t.unk[c0], t.unk[c0 + 1], t.unk[c0 + R], t.unk[c0 + R + 1]};
+      for (const auto& e : pairs) push(id[e[0]], id[e[1]], acc[4 * e[1] + e[0]]);
+      for (int v = 0; v < 4; ++v)
+        for (int c = 0; c < 3; ++c) rhs(id[v], c) += acc[16 + 4 * c + v];
+    }
+  }
+
+  // Cross products of different lookups, per (p cell, q cell) pair.
+  for (size_t p = 0; p < subs.size(); ++p)
+    for (size_t q = p + 1; q < subs.size(); ++q) {
+      const TermLayout& tp = *subs[p].t;
+      const TermLayout& tq = *subs[q].t;
+      const Lookups& lp = *subs[p].lk;
+      const Lookups& lq = *subs[q].lk;
+      const bool same = &tp == &tq;
+      const int Rp = tp.proj.res, Rq = tq.proj.res;
+      // Samples bucketed by p's cell (counting sort, sample order kept): each
+      // sample's data copied into its bucket in one pass in sample order, so
+      // the buckets are then read sequentially (gathering by sample index
+      // missed the cache on every read at 1M samples).
+      ws.count.assign(size_t(Rp) * Rp + 1, 0);
+      for (size_t k = 0; k < N; ++k) ++ws.count[lp.cell[k] + 1];
+      for (size_t c = 1; c < ws.count.size(); ++c) ws.count[c] += ws.count[c - 1];
+      ws.rec.resize(N);
+      {
+        const int* cp_ = lp.cell.data();
+        const int* cq_ = lq.cell.data();
+        const double* pa = lp.fa.data();
+        const double* pb = lp.fb.data();
+        const double* qa = lq.fa.data();
+        const double* qb = lq.fb.data();
+        SampleRec* rec = ws.rec.data();
+        int* next = ws.count.data();
+        for (size_t k = 0; k < N; ++k) rec[next[cp_[k]]++] = {pa[k], pb[k], qa[k], qb[k], w[k], cq_[k]};
+      }
+      // count[c] is now the end of bucket c (and the start of bucket c + 1).
+      ws.slot.assign(size_t(Rq) * Rq, -1);
+      size_t begin = 0;
+      for (int cp = 0; cp < Rp * Rp; ++cp) {
+        const size_t end = static_cast<size_t>(ws.count[cp]);
+        if (end == begin) continue;
+        int nslot = 0;
+        for (size_t e = begin; e < end; ++e) {
+          const SampleRec& sr = ws.rec[e];
+          const int cq = sr.cq;
+          int sl = ws.slot[cq];
+          if (sl < 0) {
+            sl = ws.slot[cq] = nslot++;
+            if (ws.slot_cell.size() < size_t(nslot)) ws.slot_cell.resize(nslot);
+            if (ws.blk.size() < 16 * size_t(nslot)) ws.blk.resize(16 * size_t(nslot));
+            ws.slot_cell[sl] = cq;
+            std::fill_n(ws.blk.data() + 16 * size_t(sl), 16, 0.0);
+          }
+          const double a = sr.pa, b = sr.pb, wk = sr.w;
+          const double sp[4] = {wk * ((1 - a) * (1 - b)), wk * (a * (1 - b)), wk * ((1 - a) * b), wk * (a * b)};
+          const double c2 = sr.qa, d2 = sr.qb;
+          const double sq[4] = {(1 - c2) * (1 - d2), c2 * (1 - d2), (1 - c2) * d2, c2 * d2};
+          double* bk = ws.blk.data() + 16 * size_t(sl);
+          for (int a2 = 0; a2 < 4; ++a2)
+            for (int b2 = 0; b2 < 4; ++b2) bk[4 * a2 + b2] += sp[a2] * sq[b2];
+        }
+        const int ip[4] = {tp.unk[cp], tp.unk[cp + 1], tp.unk[cp + Rp], tp.unk[cp + Rp + 1]};
+        for (int sl = 0; sl < nslot; ++sl) {
+          const int cq = ws.slot_cell[sl];
+          ws.slot[cq] = -1;
+          const int iq[4] = {tq.unk[cq], tq.unk[cq + 1], tq.unk[cq + Rq], tq.unk[cq + Rq + 1]};
+          const double* bk = ws.blk.data() + 16 * size_t(sl);
+          for (int a2 = 0; a2 < 4; ++a2)
+            for (int b2 = 0; b2 < 4; ++b2) {
+              const double v = bk[4 * a2 + b2];
+              if (same && ip[a2] == iq[b2]) push(ip[a2], ip[a2], 2.0 * v);
+              else push(iq[b2], ip[a2], v);
+            }
+        }
+        begin = end;
+      }
+    }
+
+  // Laplacian rows, mu L^T L.
+  for (const TermLayout& t : terms)
+    laplacian_rows(t, [&](const int* li, const double* lv, int n) {
+      for (int a = 0; a < n; ++a)
+        for (int b = 0; b < n; ++b)
+          if (li[a] >= li[b]) trip.emplace_back(li[b], li[a], mu * lv[a] * lv[b]);
+    });
+  // The prior (as add_prior_dense).
+  for (const Prior::Level& lv : prior.levels)  // Lambda - lambda lambda^T / sum(lambda)
+    for (size_t a = 0; a < lv.idx.size(); ++a)
+      for (size_t b = 0; b < lv.idx.size(); ++b)
+        if (lv.idx[a] >= lv.idx[b])
+          trip.emplace_back(lv.idx[b], lv.idx[a], (a == b ? lv.w[a] : 0.0) - lv.w[a] * lv.w[b] / lv.sum);
+  for (size_t pr = 0; pr < prior.rows(); ++pr) {
+    const double pw = prior.w[pr];
+    for (int a = prior.start[pr]; a < prior.start[pr + 1]; ++a) {
+      for (int b = prior.start[pr]; b < prior.start[pr + 1]; ++b)
+        if (prior.idx[a] >= prior.idx[b])
+          trip.emplace_back(prior.idx[b], prior.idx[a], pw * prior.val[a] * prior.val[b]);
+      for (int c = 0; c < 3; ++c) rhs(prior.idx[a], c) += pw * prior.val[a] * prior.target[pr][c];
+    }
+  }
+  A.resize(M, M);
+  A.setFromTriplets(trip.begin(), trip.end());
+  if (trip.capacity() > (size_t(4) << 20)) std::vector<Eigen::Triplet<double>>().swap(trip);
+}
+
+#ifdef BF_FACTOR_CHOLMOD
+// CHOLMOD's supernodal factorization opens OpenMP parallel regions (Debian's
+// build asks for 4 threads in its larger supernodes). The fits already run one
+// per thread (bench, search restarts), so nested threads only add wake-ups and
+// task switches (10-15% of a texture-64 fit). OpenMP's max-active-levels = 0
+// makes every parallel region run on the thread that meets it. The setter is
+// looked up at run time in the OpenMP runtime CHOLMOD loaded (nothing else in
+// the project uses OpenMP), so the library does not link one itself.
+void cholmod_serial_openmp() {
+  using Setter = void (*)(int);
+  static const Setter set = reinterpret_cast<Setter>(dlsym(RTLD_DEFAULT, "omp_set_max_active_levels"));
+  if (set) set(0);
+}
+#endif
+
 }  // namespace
 
 struct JointPrefix::Impl {
@@ -607,78 +810,98 @@ JointSolution solve_joint(const FitData& d, const std::array<std::vector<double>
   const double mu = opt.smoothing * d.W / std::max(M, 1);
   const Prior prior = extrapolation_prior(d, fixed_values, terms, lookups, M, opt);
   Eigen::MatrixXd Y(M, 3);  // solution, one column per channel
-  double quad_rel_mse = -1;  // set by the dense path when !exact_error
+  double quad_rel_mse = -1;  // set by the dense and sparse paths when !exact_error
   std::vector<int> idx(maxL);
   std::vector<double> val(maxL);
 
   FitOptions::Solver solver = opt.solver;
+  // Auto: dense up to 1,100 unknowns, or up to 1,700 with 500,000 samples or
+  // more (the sparse assembly costs more per sample); measured crossovers with
+  // the banded-head dense Cholesky (docs/speed.md, "Dense against sparse"):
+  // 43,264 samples between 946 and 1,268 unknowns, 1M samples above 1,640.
   if (solver == FitOptions::Solver::Auto)
-    solver = M <= 1500 ? FitOptions::Solver::Dense : FitOptions::Solver::Sparse;
+    solver = M <= (N >= 500000 ? 1700 : 1100) ? FitOptions::Solver::Dense : FitOptions::Solver::Sparse;
 
   if (solver == FitOptions::Solver::Sparse) {
-    using SpMat = Eigen::SparseMatrix<double>;
-    std::vector<Eigen::Triplet<double>> trip;
-    trip.reserve(N * maxL);
-    Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(M, 3);
-    for (size_t k = 0; k < N; ++k) {
-      const int L = stencil(k, idx.data(), val.data());
-      const double sw = std::sqrt(d.w[k]);
-      const double r0 = d.g[0][k] - fixed_values[0][k];
-      const double r1 = d.g[1][k] - fixed_values[1][k];
-      const double r2 = d.g[2][k] - fixed_values[2][k];
-      for (int a = 0; a < L; ++a) {
-        trip.emplace_back(static_cast<int>(k), idx[a], sw * val[a]);
-        const double wa = d.w[k] * val[a];
-        rhs(idx[a], 0) += wa * r0;
-        rhs(idx[a], 1) += wa * r1;
-        rhs(idx[a], 2) += wa * r2;
+    using SpMat = SparseUpper;
+    std::array<const double*, 3> r;
+    if (K > 0) {
+      for (int c = 0; c < 3; ++c) r[c] = prefix->impl().r[c].data();
+    } else {
+      std::array<std::vector<double>, 3>& rr = sparse_workspace().r;
+      for (int c = 0; c < 3; ++c) {
+        rr[c].resize(N);
+        for (size_t k = 0; k < N; ++k) rr[c][k] = d.g[c][k] - fixed_values[c][k];
+        r[c] = rr[c].data();
       }
     }
-    int row = static_cast<int>(N);
-    const double smu = std::sqrt(mu);
-    for (const TermLayout& t : terms)
-      laplacian_rows(t, [&](const int* li, const double* lv, int n) {
-        for (int a = 0; a < n; ++a) trip.emplace_back(row, li[a], smu * lv[a]);
-        ++row;
-      });
-    for (size_t pr = 0; pr < prior.rows(); ++pr, ++row) {
-      const double sw = std::sqrt(prior.w[pr]);
-      for (int e = prior.start[pr]; e < prior.start[pr + 1]; ++e) {
-        trip.emplace_back(row, prior.idx[e], sw * prior.val[e]);
-        for (int c = 0; c < 3; ++c) rhs(prior.idx[e], c) += prior.w[pr] * prior.val[e] * prior.target[pr][c];
-      }
-    }
-    for (const Prior::Level& lv : prior.levels)  // rows sqrt(w_i) (e_i - w / sum)
-      for (size_t a = 0; a < lv.idx.size(); ++a, ++row) {
-        const double sw = std::sqrt(lv.w[a]);
-        for (size_t b = 0; b < lv.idx.size(); ++b)
-          trip.emplace_back(row, lv.idx[b], sw * ((a == b ? 1.0 : 0.0) - lv.w[b] / lv.sum));
-      }
-    SpMat B(row, M);
-    B.setFromTriplets(trip.begin(), trip.end());
-    trip.clear();
-    trip.shrink_to_fit();
-    SpMat A = (B.transpose() * B).pruned();
-    double mean_diag = A.diagonal().sum() / std::max(M, 1);
+    SpMat A;
+    Eigen::MatrixXd rhs;
+    assemble_sparse(d, r, terms, lookups, mu, prior, M, A, rhs);
+    // Each column's diagonal entry is its last (assemble_sparse).
+    const auto diag = [&A](int i) -> double& { return A.valuePtr()[A.outerIndexPtr()[i + 1] - 1]; };
+    double mean_diag = 0;
+    for (int i = 0; i < M; ++i) mean_diag += diag(i);
+    mean_diag /= std::max(M, 1);
     // Gauge as a soft constraint on each later term's texel mean would make the
     // matrix dense in that block; in the sparse path we pin one texel of each
     // later joint term instead (same effect: removes the constant freedom).
-    for (size_t t = 1; t < terms.size(); ++t) {
-      const int i0 = terms[t].first;
-      A.coeffRef(i0, i0) += mean_diag;
-    }
-    for (int i = 0; i < M; ++i) A.coeffRef(i, i) += 1e-12 * mean_diag + std::numeric_limits<double>::min();
+    for (size_t t = 1; t < terms.size(); ++t) diag(terms[t].first) += mean_diag;
+    const double reg_diag = 1e-12 * mean_diag + std::numeric_limits<double>::min();
+    for (int i = 0; i < M; ++i) diag(i) += reg_diag;
 #ifdef BF_FACTOR_CHOLMOD
-    // SuiteSparse's supernodal Cholesky (dense BLAS blocks on the supernodes):
-    // several times faster than the simplicial LLT at texture 64 (docs/speed.md).
-    Eigen::CholmodSupernodalLLT<SpMat, Eigen::Lower> llt(A);
+    // SuiteSparse's supernodal Cholesky (dense BLAS blocks on the supernodes),
+    // with AMD as the only ordering (CHOLMOD's default also tries METIS on
+    // larger matrices: AMD gives less fill here and costs less, docs/speed.md)
+    // and CHOLMOD's OpenMP regions serial (see cholmod_serial_openmp).
+    cholmod_serial_openmp();
+    Eigen::CholmodSupernodalLLT<SpMat, Eigen::Upper> llt;
+    cholmod_common& cc = llt.cholmod();
+    cc.nmethods = 1;
+    cc.method[0].ordering = CHOLMOD_AMD;
+    cc.postorder = 1;
+    cc.print = 0;  // no CHOLMOD messages on stdout: failures are thrown below
+    llt.compute(A);
+    if (cc.status < 0)
+      throw std::runtime_error("fit: CHOLMOD failed with status " + std::to_string(cc.status) + " (" +
+                               std::to_string(M) + " unknowns)");
 #else
-    Eigen::SimplicialLLT<SpMat, Eigen::Lower, Eigen::AMDOrdering<int>> llt(A);
+    Eigen::SimplicialLLT<SpMat, Eigen::Upper, Eigen::AMDOrdering<int>> llt(A);
 #endif
     if (llt.info() != Eigen::Success)
       throw std::runtime_error("fit: the normal matrix is not positive definite (" +
                                std::to_string(M) + " unknowns)");
     Y = llt.solve(rhs);
+    if (!exact_error) {
+      // As the dense path: at the solution A y = rhs, so the data residual is
+      // sum w r^2 - y.rhs - (regularization quadratic form at y); the gauge
+      // here is the pinned texels' mean_diag y_i0^2.
+      double sum_wr2[3] = {0, 0, 0};
+      if (K > 0) {
+        for (int c = 0; c < 3; ++c) sum_wr2[c] = prefix->impl().sum_wr2[c];
+      } else {
+        for (size_t k = 0; k < N; ++k)
+          for (int c = 0; c < 3; ++c) sum_wr2[c] += d.w[k] * r[c][k] * r[c][k];
+      }
+      double se = 0;
+      for (int c = 0; c < 3; ++c) {
+        double reg = reg_diag * Y.col(c).squaredNorm();
+        for (const TermLayout& t : terms)
+          laplacian_rows(t, [&](const int* li, const double* lv, int n) {
+            double v = 0;
+            for (int a2 = 0; a2 < n; ++a2) v += lv[a2] * Y(li[a2], c);
+            reg += mu * v * v;
+          });
+        for (size_t t = 1; t < terms.size(); ++t) reg += mean_diag * Y(terms[t].first, c) * Y(terms[t].first, c);
+        for (size_t pr = 0; pr < prior.rows(); ++pr) {
+          const double by = prior.dot(pr, Y, c);
+          reg += prior.w[pr] * by * (by - 2.0 * prior.target[pr][c]);
+        }
+        for (const Prior::Level& lv : prior.levels) reg += lv.energy(Y, c);
+        se += sum_wr2[c] - Y.col(c).dot(rhs.col(c)) - reg;
+      }
+      quad_rel_mse = std::max(0.0, se) / (3.0 * d.W);
+    }
   } else if (solver == FitOptions::Solver::Dense) {
     // The normal matrix lives in the thread's workspace (no allocation once it
     // has grown); only its lower triangle is cleared, filled and factored.

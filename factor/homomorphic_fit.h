@@ -64,9 +64,10 @@ struct FitOptions {
   // interval, so the clamp never increases a training sample's error, and
   // f <= A exp(max g) ~ the largest training value everywhere. Default on.
   bool clamp_log_range = true;
-  // Dense: normal matrix assembled densely, LLT. Sparse: B assembled sparse,
-  // B^T W B by sparse product, CHOLMOD supernodal LLT (SimplicialLLT without CHOLMOD). Auto: dense up to
-  // 1500 unknowns, sparse above (measured crossover, docs/speed.md "Inner loop"). ReferenceQR: the
+  // Dense: normal matrix assembled densely, LLT. Sparse: normal matrix assembled
+  // directly in compressed columns, CHOLMOD supernodal LLT with AMD (SimplicialLLT without CHOLMOD).
+  // Auto: dense up to 1,100 unknowns (1,700 with 500,000 samples or more), sparse above (measured
+  // crossovers, docs/speed.md "Sparse path"). ReferenceQR: the
   // simple path (dense B, Householder QR, no normal equations) for tests.
   enum class Solver { Auto, Dense, Sparse, ReferenceQR } solver = Solver::Auto;
   // Throws std::invalid_argument naming the field, its value and the rule.
