@@ -234,6 +234,25 @@ Workspace& workspace() {
   return ws;
 }
 
+// Emits one lookup's per-cell sums (kernels::cell_sums' layout: Q (i, j) at
+// 4 j + i, R at 16 + 4 c + v) for term t: add(i, j, v) for the 10 entries i >= j
+// (corner order) of every cell's 4x4 self product, with i, j unknowns, and the
+// 4 x 3 right-hand side sums into rhs. Cells no sample fell into are skipped.
+template <class Add>
+void scatter_cell_sums(const TermLayout& t, const double* cells, Eigen::Ref<Eigen::MatrixXd> rhs, Add add) {
+  static constexpr int pairs[10][2] = {{0, 0}, {1, 0}, {2, 0}, {3, 0}, {1, 1},
+                                       {2, 1}, {3, 1}, {2, 2}, {3, 2}, {3, 3}};
+  const int R = t.proj.res;
+  for (size_t c0 = 0; c0 < size_t(R) * R; ++c0) {
+    const double* acc = cells + c0 * kernels::kCellDoubles;
+    if (acc[0] == 0 && acc[5] == 0 && acc[10] == 0 && acc[15] == 0) continue;
+    const int id[4] = {t.unk[c0], t.unk[c0 + 1], t.unk[c0 + R], t.unk[c0 + R + 1]};
+    for (const auto& e : pairs) add(id[e[0]], id[e[1]], acc[4 * e[1] + e[0]]);
+    for (int v = 0; v < 4; ++v)
+      for (int c = 0; c < 3; ++c) rhs(id[v], c) += acc[16 + 4 * c + v];
+  }
+}
+
 // The data part of the dense normal equations (lower triangle of A, rhs and
 // sum w r^2 per channel) for terms first_new.. and their products with the
 // earlier terms; blocks among terms before first_new are left as they are (a
@@ -354,19 +373,8 @@ void assemble_dense(const FitData& d, const std::array<const double*, 3>& r,
     const Lookups& lk = *subs[p].lk;
     kernels::cell_sums(N, lk.cell.data(), lk.fa.data(), lk.fb.data(), w, r[0], r[1], r[2], ws.cells.data());
     // Scatter the per-cell sums into the lower triangle and the right-hand side.
-    const int pairs[10][2] = {{0, 0}, {1, 0}, {2, 0}, {3, 0}, {1, 1},
-                              {2, 1}, {3, 1}, {2, 2}, {3, 2}, {3, 3}};
-    for (size_t c0 = 0; c0 < size_t(R) * R; ++c0) {
-      const double* acc = ws.cells.data() + c0 * kernels::kCellDoubles;  // Q (i, j) at 4 j + i, R at 16 + 4 c + v
-      if (acc[0] == 0 && acc[5] == 0 && acc[10] == 0 && acc[15] == 0) continue;
-      const int id[4] = {t.unk[c0], t.unk[c0 + 1], t.unk[c0 + R], t.unk[c0 + R + 1]};
-      for (const auto& e : pairs) {
-        const int i = id[e[0]], j = id[e[1]];
-        A(std::max(i, j), std::min(i, j)) += acc[4 * e[1] + e[0]];
-      }
-      for (int v = 0; v < 4; ++v)
-        for (int c = 0; c < 3; ++c) rhs(id[v], c) += acc[16 + 4 * c + v];
-    }
+    scatter_cell_sums(t, ws.cells.data(), rhs,
+                      [&A](int i, int j, double v) { A(std::max(i, j), std::min(i, j)) += v; });
   }
 
 }
@@ -588,16 +596,7 @@ void assemble_sparse(const FitData& d, const std::array<const double*, 3>& r,
     ws.cells.assign(size_t(R) * R * kernels::kCellDoubles, 0.0);
     kernels::cell_sums(N, s.lk->cell.data(), s.lk->fa.data(), s.lk->fb.data(), w, r[0], r[1], r[2],
                        ws.cells.data());
-    static constexpr int pairs[10][2] = {{0, 0}, {1, 0}, {2, 0}, {3, 0}, {1, 1},
-                                         {2, 1}, {3, 1}, {2, 2}, {3, 2}, {3, 3}};
-    for (size_t c0 = 0; c0 < size_t(R) * R; ++c0) {
-      const double* acc = ws.cells.data() + c0 * kernels::kCellDoubles;  // Q (i, j) at 4 j + i, R at 16 + 4 c + v
-      if (acc[0] == 0 && acc[5] == 0 && acc[10] == 0 && acc[15] == 0) continue;
-      const int id[4] = {t.unk[c0], t.unk[c0 + 1], t.unk[c0 + R], t.unk[c0 + R + 1]};
-      for (const auto& e : pairs) push(id[e[0]], id[e[1]], acc[4 * e[1] + e[0]]);
-      for (int v = 0; v < 4; ++v)
-        for (int c = 0; c < 3; ++c) rhs(id[v], c) += acc[16 + 4 * c + v];
-    }
+    scatter_cell_sums(t, ws.cells.data(), rhs, push);
   }
 
   // Cross products of different lookups, per (p cell, q cell) pair.
