@@ -502,6 +502,36 @@ Prior extrapolation_prior(const FitData& d, const std::array<std::vector<double>
   return p;
 }
 
+// The least-squares objective (rel_mse, unclamped) read off the normal
+// equations at their solution Y (A Y = rhs): the data residual is
+// sum w r^2 - y.rhs - (the regularization's quadratic form at y), the latter
+// being ridge (reg_diag |y|^2), Laplacian (mu |L y|^2), gauge (gauge(c), the
+// path's own penalty) and prior (its rows w b b^T and w c b restored by
+// sum_r w_r ((b_r.y)^2 - 2 c_r (b_r.y)), plus the levels' energy).
+template <class Gauge>
+double objective_from_solution(const FitData& d, const std::vector<TermLayout>& terms, const Prior& prior,
+                               const Eigen::MatrixXd& Y, const Eigen::MatrixXd& rhs, const double sum_wr2[3],
+                               double mu, double reg_diag, Gauge gauge) {
+  double se = 0;
+  for (int c = 0; c < 3; ++c) {
+    double reg = reg_diag * Y.col(c).squaredNorm();
+    for (const TermLayout& t : terms)
+      laplacian_rows(t, [&](const int* li, const double* lv, int n) {
+        double v = 0;
+        for (int a2 = 0; a2 < n; ++a2) v += lv[a2] * Y(li[a2], c);
+        reg += mu * v * v;
+      });
+    reg += gauge(c);
+    for (size_t pr = 0; pr < prior.rows(); ++pr) {
+      const double by = prior.dot(pr, Y, c);
+      reg += prior.w[pr] * by * (by - 2.0 * prior.target[pr][c]);
+    }
+    for (const Prior::Level& lv : prior.levels) reg += lv.energy(Y, c);
+    se += sum_wr2[c] - Y.col(c).dot(rhs.col(c)) - reg;
+  }
+  return std::max(0.0, se) / (3.0 * d.W);
+}
+
 // Adds the prior to a dense normal matrix (lower triangle) and rhs.
 void add_prior_dense(const Prior& p, Eigen::Ref<Eigen::MatrixXd> A, Eigen::MatrixXd* rhs) {
   for (const Prior::Level& lv : p.levels)  // Lambda - lambda lambda^T / sum(lambda)
@@ -882,24 +912,11 @@ JointSolution solve_joint(const FitData& d, const std::array<std::vector<double>
         for (size_t k = 0; k < N; ++k)
           for (int c = 0; c < 3; ++c) sum_wr2[c] += d.w[k] * r[c][k] * r[c][k];
       }
-      double se = 0;
-      for (int c = 0; c < 3; ++c) {
-        double reg = reg_diag * Y.col(c).squaredNorm();
-        for (const TermLayout& t : terms)
-          laplacian_rows(t, [&](const int* li, const double* lv, int n) {
-            double v = 0;
-            for (int a2 = 0; a2 < n; ++a2) v += lv[a2] * Y(li[a2], c);
-            reg += mu * v * v;
-          });
-        for (size_t t = 1; t < terms.size(); ++t) reg += mean_diag * Y(terms[t].first, c) * Y(terms[t].first, c);
-        for (size_t pr = 0; pr < prior.rows(); ++pr) {
-          const double by = prior.dot(pr, Y, c);
-          reg += prior.w[pr] * by * (by - 2.0 * prior.target[pr][c]);
-        }
-        for (const Prior::Level& lv : prior.levels) reg += lv.energy(Y, c);
-        se += sum_wr2[c] - Y.col(c).dot(rhs.col(c)) - reg;
-      }
-      quad_rel_mse = std::max(0.0, se) / (3.0 * d.W);
+      quad_rel_mse = objective_from_solution(d, terms, prior, Y, rhs, sum_wr2, mu, reg_diag, [&](int c) {
+        double g = 0;  // the pinned texels' mean_diag y_i0^2
+        for (size_t t = 1; t < terms.size(); ++t) g += mean_diag * Y(terms[t].first, c) * Y(terms[t].first, c);
+        return g;
+      });
     }
   } else if (solver == FitOptions::Solver::Dense) {
     // The normal matrix lives in the thread's workspace (no allocation once it
@@ -970,30 +987,14 @@ JointSolution solve_joint(const FitData& d, const std::array<std::vector<double>
     if (!exact_error) {
       // At the solution A y = rhs, so the data residual is
       // sum w r^2 - y.rhs - (regularization quadratic form at y).
-      double se = 0;
-      for (int c = 0; c < 3; ++c) {
-        double reg = reg_diag * Y.col(c).squaredNorm();
-        for (const TermLayout& t : terms) {
-          laplacian_rows(t, [&](const int* li, const double* lv, int n) {
-            double v = 0;
-            for (int a2 = 0; a2 < n; ++a2) v += lv[a2] * Y(li[a2], c);
-            reg += mu * v * v;
-          });
-        }
+      quad_rel_mse = objective_from_solution(d, terms, prior, Y, rhs, sum_wr2, mu, reg_diag, [&](int c) {
+        double g = 0;  // gamma (sum of the term's texels)^2 per later joint term
         for (size_t t = 1; t < terms.size(); ++t) {
           const double sum = Y.col(c).segment(terms[t].first, terms[t].count).sum();
-          reg += mean_diag / terms[t].count * sum * sum;
+          g += mean_diag / terms[t].count * sum * sum;
         }
-        // The prior adds w b b^T to the matrix and w c b to rhs:
-        // sum_r w_r ((b_r.y)^2 - 2 c_r (b_r.y)) restores the data residual.
-        for (size_t pr = 0; pr < prior.rows(); ++pr) {
-          const double by = prior.dot(pr, Y, c);
-          reg += prior.w[pr] * by * (by - 2.0 * prior.target[pr][c]);
-        }
-        for (const Prior::Level& lv : prior.levels) reg += lv.energy(Y, c);
-        se += sum_wr2[c] - Y.col(c).dot(rhs.col(c)) - reg;
-      }
-      quad_rel_mse = std::max(0.0, se) / (3.0 * d.W);
+        return g;
+      });
     }
   } else {
     // Reference path: form B (data rows, Laplacian rows, gauge rows) densely and
