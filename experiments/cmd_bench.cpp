@@ -151,6 +151,7 @@ void run_bench_fit(const BenchFitArgs& a) {
 struct BenchSearchArgs {
   std::string brdf = "bluepaint";
   int grid = 16;
+  std::string sampling = "grid";  // or "measured" (the BRDF's own samples)
   int texture = 16;
   int search_texture = 0;
   int terms = 5;
@@ -216,6 +217,7 @@ nlohmann::json bench_one_search(const BenchSearchArgs& a, const FitData& d, cons
   j["brdf"] = a.brdf;
   j["parameterization"] = a.param;
   j["reciprocity"] = a.reciprocity;
+  j["sampling"] = a.sampling;
   j["samples"] = d.size();
   j["texture"] = a.texture;
   j["search_texture"] = a.search_texture > 0 ? a.search_texture : a.texture;
@@ -252,7 +254,7 @@ nlohmann::json bench_one_search(const BenchSearchArgs& a, const FitData& d, cons
 
 void run_bench_search(const BenchSearchArgs& a) {
   const BrdfPtr brdf = Catalogue::builtin().make(a.brdf);
-  const SampleSet s = sample_grid(*brdf, a.grid);
+  const SampleSet s = a.sampling == "measured" ? measured_samples(*brdf) : sample_grid(*brdf, a.grid);
   const FitData d(s, FitOptions{}.eps);
   if (a.strategy != "both") {
     bench_one_search(a, d, a.strategy);
@@ -539,6 +541,9 @@ void add_cmd_bench(CLI::App& app) {
   auto b = std::make_shared<BenchSearchArgs>();
   search->add_option("--brdf", b->brdf, "catalogue name or measured file")->capture_default_str();
   search->add_option("--grid", b->grid, "regular res^4 parabolic grid")->capture_default_str();
+  search->add_option("--sampling", b->sampling, "grid (--grid) or measured (a measured BRDF's own samples)")
+      ->check(CLI::IsMember({"grid", "measured"}))
+      ->capture_default_str();
   search->add_option("--texture", b->texture, "final texture resolution")->capture_default_str();
   search->add_option("--search-texture", b->search_texture, "texture during the search (0 = final)")
       ->capture_default_str();
