@@ -18,6 +18,7 @@
 #include "experiments/commands.h"
 #include "factor/dense_kernels.h"
 #include "factor/homomorphic_fit.h"
+#include "search/powell.h"
 #include "search/rotation4.h"
 #include "search/planted.h"
 #include "search/term_search.h"
@@ -211,6 +212,7 @@ void run_bench_fit(const BenchFitArgs& a) {
 struct BenchSearchArgs {
   std::string brdf = "bluepaint";
   int grid = 16;
+  std::string sampling = "grid";  // or "measured" (the BRDF's own samples)
   int texture = 16;
   int search_texture = 0;
   int terms = 5;
@@ -276,6 +278,7 @@ nlohmann::json bench_one_search(const BenchSearchArgs& a, const FitData& d, cons
   j["brdf"] = a.brdf;
   j["parameterization"] = a.param;
   j["reciprocity"] = a.reciprocity;
+  j["sampling"] = a.sampling;
   j["samples"] = d.size();
   j["texture"] = a.texture;
   j["search_texture"] = a.search_texture > 0 ? a.search_texture : a.texture;
@@ -312,7 +315,7 @@ nlohmann::json bench_one_search(const BenchSearchArgs& a, const FitData& d, cons
 
 void run_bench_search(const BenchSearchArgs& a) {
   const BrdfPtr brdf = Catalogue::builtin().make(a.brdf);
-  const SampleSet s = sample_grid(*brdf, a.grid);
+  const SampleSet s = a.sampling == "measured" ? measured_samples(*brdf) : sample_grid(*brdf, a.grid);
   const FitData d(s, FitOptions{}.eps);
   if (a.strategy != "both") {
     bench_one_search(a, d, a.strategy);
@@ -337,6 +340,83 @@ void run_bench_search(const BenchSearchArgs& a) {
                n["evaluations"].get<int>(), n["seconds"].get<double>(),
                n["rel_mse_after_term"].back().get<double>());
 }
+// The line searches side by side on the first term's objective (the
+// search's objective for term 1 at the search texture): from `starts` seeded
+// random rotations (after `presweeps` golden Powell sweeps when > 0, i.e.
+// nearer a minimum, as in the search's later lines), each of Cole's six
+// directions is minimized by the golden section and by Brent from the same
+// point. Counts the evaluations of each and compares the values they reach,
+// line by line: no chaos of the search's path, the per-line quality.
+struct BenchLinesArgs : BenchSearchArgs {
+  int starts = 10;
+  int presweeps = 0;
+};
+
+void run_bench_lines(const BenchLinesArgs& a) {
+  if (a.starts < 1 || a.starts > 10000)
+    throw std::invalid_argument("--starts: expected 1..10000, found " + std::to_string(a.starts));
+  if (a.presweeps < 0 || a.presweeps > 30)
+    throw std::invalid_argument("--presweeps: expected 0..30, found " + std::to_string(a.presweeps));
+  const BrdfPtr brdf = Catalogue::builtin().make(a.brdf);
+  const SampleSet s = a.sampling == "measured" ? measured_samples(*brdf) : sample_grid(*brdf, a.grid);
+  const FitData d(s, FitOptions{}.eps);
+  const SearchOptions opt = bench_search_options(a, "greedy");
+  opt.validate();  // texture, line_tol, ... named as for bench search
+  const int res = a.search_texture > 0 ? a.search_texture : a.texture;
+  const TermObjective f(d, {}, {}, opt, res);
+  PowellOptions gold = opt.powell, brent = opt.powell;
+  gold.line_search = PowellOptions::LineSearch::Golden;
+  brent.line_search = PowellOptions::LineSearch::Brent;
+  int lines = 0, eval_gold = 0, eval_brent = 0, lower = 0, equal = 0, higher = 0;
+  double worst = 0, gain_gold = 0, gain_brent = 0;
+  std::vector<double> rel;
+  for (int k = 0; k < a.starts; ++k) {
+    std::mt19937_64 rng(a.seed * 1000003ull + static_cast<uint64_t>(k));
+    Rotation4 start = Rotation4::random(rng);
+    if (a.presweeps > 0) {
+      PowellOptions p = gold;
+      p.max_sweeps = a.presweeps;
+      start = powell_minimize(f, start, p).best;
+    }
+    const double f0 = f(start);
+    for (const Rotation4& D : cole_basis_directions()) {
+      const LineDirection dir = LineDirection::from(D);
+      double tg, tb;
+      const double vg = line_minimize(f, start, f0, dir, gold, &tg, &eval_gold);
+      const double vb = line_minimize(f, start, f0, dir, brent, &tb, &eval_brent);
+      ++lines;
+      if (vb < vg) ++lower;
+      else if (vb == vg) ++equal;
+      else ++higher;
+      const double r = (vb - vg) / std::max(std::abs(vg), 1e-300);
+      rel.push_back(r);
+      worst = std::max(worst, r);
+      gain_gold += f0 - vg;
+      gain_brent += f0 - vb;
+    }
+  }
+  std::sort(rel.begin(), rel.end());
+  nlohmann::json j;
+  j["bench"] = "lines";
+  j["brdf"] = a.brdf;
+  j["sampling"] = a.sampling;
+  j["samples"] = d.size();
+  j["parameterization"] = a.param;
+  j["search_texture"] = res;
+  j["line_tol"] = a.line_tol;
+  j["presweeps"] = a.presweeps;
+  j["lines"] = lines;
+  j["golden_evaluations"] = eval_gold;
+  j["brent_evaluations"] = eval_brent;
+  j["brent_lower"] = lower;
+  j["equal"] = equal;
+  j["brent_higher"] = higher;
+  j["median_rel_difference"] = rel[rel.size() / 2];  // (brent - golden) / golden
+  j["max_rel_higher"] = worst;
+  j["improvement_ratio"] = gain_gold > 0 ? gain_brent / gain_gold : 0.0;  // sum of (f0 - v), brent / golden
+  std::cout << j.dump() << std::endl;
+}
+
 struct BenchPlantedArgs {
   std::string family = "rotation";  // or "mccool"
   int count = 8;
@@ -602,6 +682,9 @@ void add_cmd_bench(CLI::App& app) {
   auto b = std::make_shared<BenchSearchArgs>();
   search->add_option("--brdf", b->brdf, "catalogue name or measured file")->capture_default_str();
   search->add_option("--grid", b->grid, "regular res^4 parabolic grid")->capture_default_str();
+  search->add_option("--sampling", b->sampling, "grid (--grid) or measured (a measured BRDF's own samples)")
+      ->check(CLI::IsMember({"grid", "measured"}))
+      ->capture_default_str();
   search->add_option("--texture", b->texture, "final texture resolution")->capture_default_str();
   search->add_option("--search-texture", b->search_texture, "texture during the search (0 = final)")
       ->capture_default_str();
@@ -639,6 +722,23 @@ void add_cmd_bench(CLI::App& app) {
   search->add_option("--polish-sweeps", b->polish_sweeps, "structured: joint re-search sweeps at the end")
       ->capture_default_str();
   search->callback([b] { run_bench_search(*b); });
+
+  auto* lines = bench->add_subcommand(
+      "lines", "Golden section against Brent, line by line, on the first term's search objective");
+  auto la = std::make_shared<BenchLinesArgs>();
+  lines->add_option("--brdf", la->brdf, "catalogue name or measured file")->capture_default_str();
+  lines->add_option("--grid", la->grid, "regular res^4 parabolic grid")->capture_default_str();
+  lines->add_option("--sampling", la->sampling, "grid (--grid) or measured (a measured BRDF's own samples)")
+      ->check(CLI::IsMember({"grid", "measured"}))
+      ->capture_default_str();
+  lines->add_option("--texture", la->texture, "texture resolution of the objective")->capture_default_str();
+  lines->add_option("--parameterization", la->param, "wiwo or halfdiff")->capture_default_str();
+  lines->add_option("--seed", la->seed, "seed of the random starts")->capture_default_str();
+  lines->add_option("--line-tol", la->line_tol, "golden-section bracket width (t)")->capture_default_str();
+  lines->add_option("--starts", la->starts, "random starting rotations (6 lines each)")->capture_default_str();
+  lines->add_option("--presweeps", la->presweeps, "golden Powell sweeps from each start before the lines")
+      ->capture_default_str();
+  lines->callback([la] { run_bench_lines(*la); });
 
   auto* planted = bench->add_subcommand(
       "planted", "Planted product BRDFs: McCool, greedy and structured search, floor (fit at the true projections)");

@@ -41,13 +41,13 @@ namespace {
 // so far, a golden-section step whenever the parabola's step is outside the
 // bracket or does not shrink fast enough (more than half the step before
 // last). Stops when x is within the tolerance of the bracket's middle, i.e.
-// the bracket is about line_tol wide, as for the golden section. The first
+// the bracket is about `width` wide (the caller passes
+// kBrentBracketFraction * line_tol). The first
 // parabola goes through the bracket itself, so it costs no extra evaluation.
-template <class G>
-double brent_refine(G& g, double lo, double flo, double x, double fx, double hi, double fhi,
-                    double line_tol, double* best_t) {
+double brent_refine(const LineFunction& g, double lo, double flo, double x, double fx, double hi, double fhi,
+                    double width, double* best_t) {
   constexpr double kCGold = 0.3819660112501051;  // 1 - 1/golden ratio
-  const double tol = 0.25 * line_tol;
+  const double tol = 0.25 * width;
   double a = lo, b = hi;
   // w: second best point, v: third best (the previous w).
   double w = flo <= fhi ? lo : hi, fw = std::min(flo, fhi);
@@ -101,18 +101,11 @@ double brent_refine(G& g, double lo, double flo, double x, double fx, double hi,
 
 }  // namespace
 
-double line_minimize(const RotationObjective& f, const Rotation4& start, double f0,
-                     const LineDirection& dir, const PowellOptions& opt, double* best_t,
-                     int* evals) {
+double line_minimize_1d(const LineFunction& g, double f0, const PowellOptions& opt, double* best_t) {
   constexpr double kGold = 1.618033988749895;
   constexpr double kR = 0.6180339887498949;  // 1 / golden ratio
   const double kMaxT = 2 * M_PI;             // half the 4 pi period on either side
-  auto g = [&](double t) {
-    ++*evals;
-    return f(dir.at(start, t));
-  };
   *best_t = 0.0;
-  if (dir.is_zero()) return f0;
 
   // Bracket (a, b, c) with g(b) <= g(a), g(b) <= g(c), starting at t = 0.
   double a = 0.0, fa = f0;
@@ -122,7 +115,7 @@ double line_minimize(const RotationObjective& f, const Rotation4& start, double 
     if (fbm >= fa) {
       // (bm, 0, b) already brackets a minimum at the start.
       if (opt.line_search == PowellOptions::LineSearch::Brent)
-        return brent_refine(g, bm, fbm, 0.0, f0, b, fb, opt.line_tol, best_t);
+        return brent_refine(g, bm, fbm, 0.0, f0, b, fb, kBrentBracketFraction * opt.line_tol, best_t);
       double lo = bm, hi = b, x1, x2, f1, f2;
       x1 = hi - kR * (hi - lo);
       x2 = lo + kR * (hi - lo);
@@ -161,8 +154,8 @@ double line_minimize(const RotationObjective& f, const Rotation4& start, double 
   }
   if (opt.line_search == PowellOptions::LineSearch::Brent) {
     double bt;
-    const double bv = a < c ? brent_refine(g, a, fa, b, fb, c, fc, opt.line_tol, &bt)
-                            : brent_refine(g, c, fc, b, fb, a, fa, opt.line_tol, &bt);
+    const double bv = a < c ? brent_refine(g, a, fa, b, fb, c, fc, kBrentBracketFraction * opt.line_tol, &bt)
+                            : brent_refine(g, c, fc, b, fb, a, fa, kBrentBracketFraction * opt.line_tol, &bt);
     // Never worse than the start (a = 0 unless the bracket moved on).
     if (f0 <= bv) {
       *best_t = 0.0;
@@ -192,6 +185,19 @@ double line_minimize(const RotationObjective& f, const Rotation4& start, double 
   if (f0 <= bv) { bt = 0.0; bv = f0; }
   *best_t = bt;
   return bv;
+}
+
+double line_minimize(const RotationObjective& f, const Rotation4& start, double f0,
+                     const LineDirection& dir, const PowellOptions& opt, double* best_t,
+                     int* evals) {
+  *best_t = 0.0;
+  if (dir.is_zero()) return f0;
+  return line_minimize_1d(
+      [&](double t) {
+        ++*evals;
+        return f(dir.at(start, t));
+      },
+      f0, opt, best_t);
 }
 
 PowellResult powell_minimize(const RotationObjective& f, const Rotation4& start,

@@ -354,6 +354,8 @@ TEST_CASE("hostile options: sizes that would allocate without bound are refused 
       {{"bench", "fit", "--samples", "100000000"}, "--samples: expected 0..10000000, found 100000000"},
       {{"bench", "search", "--terms", "100000"}, "terms: expected 1..64, found 100000"},
       {{"bench", "search", "--restarts", "100000000"}, "restarts: expected 0..100000, found 100000000"},
+      {{"bench", "lines", "--starts", "100000000"}, "--starts: expected 1..10000, found 100000000"},
+      {{"bench", "lines", "--texture", "100000"}, "texture_size: expected 2..1024, found 100000"},
       {{"sample", "--brdf", "bluepaint", "--out", d / "s.csv", "--stratified", "100000000"},
        "stratified count: expected 1..10000000"},
       {{"sample", "--brdf", "bluepaint", "--out", d / "s.csv", "--grid", "200"}, "grid resolution: expected 2..64"},
