@@ -14,6 +14,11 @@
 
 namespace bf {
 
+double structure_radius(size_t samples) {
+  const double n = static_cast<double>(std::max<size_t>(samples, 1));
+  return std::min(0.8, StructureOptions{}.radius * std::max(1.0, std::pow(40000.0 / n, 0.25)));
+}
+
 std::vector<Eigen::Matrix4d> local_hessians(const std::vector<Vec4>& x, const std::vector<double>& y,
                                             const std::vector<double>& w, const StructureOptions& opt) {
   const size_t N = x.size();

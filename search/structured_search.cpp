@@ -168,6 +168,7 @@ std::vector<std::pair<Parameterization, PlaneSplit>> Structured::seeds(const std
   std::vector<std::pair<Parameterization, PlaneSplit>> out;
   StructureOptions so;
   so.seed = opt_.seed;
+  so.radius = structure_radius(d_.size());
   for (Parameterization p : params_) {
     const std::vector<Eigen::Matrix4d> hs = local_hessians(d_.points(p), y, d_.w, so);
     if (hs.empty()) continue;
