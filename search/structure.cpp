@@ -14,6 +14,11 @@
 
 namespace bf {
 
+double structure_radius(size_t samples) {
+  const double n = static_cast<double>(std::max<size_t>(samples, 1));
+  return std::min(0.8, StructureOptions{}.radius * std::max(1.0, std::pow(40000.0 / n, 0.25)));
+}
+
 std::vector<Eigen::Matrix4d> local_hessians(const std::vector<Vec4>& x, const std::vector<double>& y,
                                             const std::vector<double>& w, const StructureOptions& opt) {
   const size_t N = x.size();
@@ -129,34 +134,57 @@ PlaneSplit split_planes(const std::vector<Eigen::Matrix4d>& hessians) {
     M += H * H;
   }
   if (!(total > 0)) total = 1;
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix4d> es(M);
-  const Eigen::Matrix4d V = es.eigenvectors();
   const int pairings[3][4] = {{3, 2, 1, 0}, {3, 1, 2, 0}, {3, 0, 2, 1}};
   const auto objective = [&](const Rotation4& R) {
     double o, a;
     block_energies(hs, R.normalized().matrix(), &o, &a);
     return o / total;
   };
-  // The three pairings of the eigenvectors; Powell polishes the best one
-  // (near-degenerate eigenvalues mix the planes' eigenvectors, which Powell undoes).
   PowellOptions po;
   po.ftol = 1e-6;
   po.line_tol = 1e-3;
   po.max_evaluations = 1500;
-  PlaneSplit best;
-  double best_start = std::numeric_limits<double>::infinity();
-  for (const auto& p : pairings) {
-    Eigen::Matrix4d Q;
-    for (int c = 0; c < 4; ++c) Q.col(c) = V.col(p[c]);
-    if (Q.determinant() < 0) Q.col(3) = -Q.col(3);
-    const Rotation4 R = Rotation4::from_matrix(Q);
-    const double v = objective(R);
-    if (v < best_start) {
-      best_start = v;
-      best.first = R;
+  // The best of a frame's three pairings as a start: {value, rotation}.
+  const auto best_pairing = [&](const Eigen::Matrix4d& V) {
+    std::pair<double, Rotation4> out{std::numeric_limits<double>::infinity(), Rotation4::identity()};
+    for (const auto& p : pairings) {
+      Eigen::Matrix4d Q;
+      for (int c = 0; c < 4; ++c) Q.col(c) = V.col(p[c]);
+      if (Q.determinant() < 0) Q.col(3) = -Q.col(3);
+      const Rotation4 R = Rotation4::from_matrix(Q);
+      const double v = objective(R);
+      if (v < out.first) out = {v, R};
     }
+    return out;
+  };
+  // The eigenvectors of sum H^2, best pairing, polished by Powell
+  // (near-degenerate eigenvalues mix the planes' eigenvectors, which Powell
+  // undoes when the mixing is slight).
+  PlaneSplit best;
+  best.first = powell_minimize(objective, best_pairing(Eigen::SelfAdjointEigenSolver<Eigen::Matrix4d>(M).eigenvectors()).second, po)
+                   .best.normalized();
+  // When an eigenvalue of one block is near one of the other, the eigenvectors
+  // of sum H^2 mix the planes so much that Powell ends in a mixed local
+  // minimum (off-block 0.077 on planted member 12, 2 terms, halfdiff, grid 16,
+  // where the true planes give 0.001). Random combinations sum c_k H_k are
+  // block-diagonal too, with other eigenvalues: the best pairing over 16 of
+  // them is polished too when it starts below that minimum, and replaces it
+  // when it ends below half of it (so on data without that structure, such as
+  // measured BRDFs, the seed of sum H^2 stays unless it is clearly beaten).
+  const double v0 = objective(best.first);
+  std::mt19937_64 rng(0x5b1175ull);
+  std::normal_distribution<double> N01(0, 1);
+  std::pair<double, Rotation4> alt{std::numeric_limits<double>::infinity(), Rotation4::identity()};
+  for (int f = 0; f < 16; ++f) {
+    Eigen::Matrix4d C = Eigen::Matrix4d::Zero();
+    for (const Eigen::Matrix4d& H : hs) C += N01(rng) * H;
+    const auto s = best_pairing(Eigen::SelfAdjointEigenSolver<Eigen::Matrix4d>(C).eigenvectors());
+    if (s.first < alt.first) alt = s;
   }
-  best.first = powell_minimize(objective, best.first, po).best.normalized();
+  if (alt.first < v0) {
+    const Rotation4 R1 = powell_minimize(objective, alt.second, po).best.normalized();
+    if (objective(R1) < 0.5 * v0) best.first = R1;
+  }
   Eigen::Matrix4d Q = best.first.matrix();
   double off, a;
   block_energies(hessians, Q, &off, &a);

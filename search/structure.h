@@ -25,6 +25,15 @@ struct StructureOptions {
   uint64_t seed = 1;       // choice of the centres
 };
 
+// The neighbourhood radius for a set of n samples (the structured search's):
+// StructureOptions' 0.35 at 40,000 samples or more (a 16^4 parabolic grid
+// holds 43,264), growing as n^(-1/4) below, so that a ball holds about as many
+// samples, at most 0.8. At 0.35 the local quadratic fits on a 10^4 grid (6,400
+// samples) are too noisy to split the planes: 15 of the planted wiwo family's
+// members 0..63 got mixed seed planes (off-block 0.07-0.21); at 0.55, none
+// (grids 8 and 12 likewise).
+double structure_radius(size_t samples);
+
 // Hessians (4x4, symmetric) of y at up to opt.centres sample points, by a local
 // quadratic least-squares fit with weights w_k (1 - (d/r)^2)^2 over the
 // samples within opt.radius. x and y have one entry per sample; w may be empty

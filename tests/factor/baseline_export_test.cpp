@@ -18,6 +18,7 @@
 #include "factor/baseline_export.h"
 #include "factor/export.h"
 #include "factor/glsl_compile.h"
+#include "factor/glsl_run.h"
 #include "factor/image_io.h"
 #include "factor/sh_baseline.h"
 #include "factor/svd_baseline.h"
@@ -93,47 +94,13 @@ void check_glsl(const Factorization& f, const BaselineExportFiles& files, const 
   const std::string err = bf_test::compile_glsl_all_targets(glsl, dir);
   INFO(err);
   CHECK(err.empty());
-  const auto pr = pairs(200);
-  {
-    std::ofstream d(dir / "dirs.txt");
-    d.precision(17);
-    for (const auto& [wi, wo] : pr)
-      d << wi.x() << " " << wi.y() << " " << wi.z() << " " << wo.x() << " " << wo.y() << " " << wo.z() << "\n";
-  }
-  const std::filesystem::path runner = std::filesystem::read_symlink("/proc/self/exe").parent_path() / "bf_glsl_run";
-  INFO("GLSL runner " << runner.string() << " (built with the tests; needs Mesa's EGL: scripts/install-deps.sh)");
-  REQUIRE(std::filesystem::exists(runner));
-  std::string cmd = runner.string() + " " + files.glsl + " " + (dir / "dirs.txt").string() + " " +
-                    (dir / "out.txt").string();
   const auto textures = read_json(files.sidecar).at("textures");
   REQUIRE(textures.size() == files.textures.size());
-  for (size_t k = 0; k < files.textures.size(); ++k) {
-    cmd += ' ';
-    cmd += textures[k].at("sampler").get<std::string>();
-    cmd += '=';
-    cmd += files.textures[k];
-  }
-  cmd += " > ";
-  cmd += (dir / "run.log").string();
-  cmd += " 2>&1";
-  const int rc = std::system(cmd.c_str());
-  INFO(bf_test::slurp((dir / "run.log").string()));
-  REQUIRE(rc == 0);
-  std::vector<Rgb> cpu;
-  double peak = 0.0;
-  for (const auto& [wi, wo] : pr) {
-    cpu.push_back(f.eval(wi, wo));
-    peak = std::max(peak, cpu.back().abs().maxCoeff());
-  }
-  REQUIRE(peak > 0.0);
-  std::ifstream out(dir / "out.txt");
-  double worst = 0.0;
-  for (const Rgb& c : cpu) {
-    Rgb g;
-    REQUIRE(out >> g[0] >> g[1] >> g[2]);
-    for (int ch = 0; ch < 3; ++ch)
-      worst = std::max(worst, std::abs(g[ch] - c[ch]) / std::max(std::abs(c[ch]), 1e-3 * peak));
-  }
+  std::vector<std::pair<std::string, std::string>> samplers;
+  for (size_t k = 0; k < files.textures.size(); ++k)
+    samplers.emplace_back(textures[k].at("sampler").get<std::string>(), files.textures[k]);
+  const double worst = bf_test::glsl_run_error(
+      files.glsl, pairs(200), samplers, [&](const Vec3& wi, const Vec3& wo) { return f.eval(wi, wo); }, dir);
   INFO(f.to_string() << ": worst relative |GLSL - eval| " << worst);
   CHECK(worst < tol);
 }

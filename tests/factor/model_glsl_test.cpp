@@ -12,6 +12,7 @@
 #include "brdfs/directions.h"
 #include "brdfs/sampleset.h"
 #include "factor/glsl_compile.h"
+#include "factor/glsl_run.h"
 #include "factor/model_fit.h"
 #include "factor/model_glsl.h"
 #include "test_common.h"
@@ -48,11 +49,6 @@ std::vector<std::pair<Vec3, Vec3>> pairs() {
   return out;
 }
 
-const fs::path& runner() {
-  static const fs::path r = fs::read_symlink("/proc/self/exe").parent_path() / "bf_glsl_run";
-  return r;
-}
-
 // Compiles the model's GLSL for the four targets (with all_targets) and runs
 // it on llvmpipe at pairs(); returns the worst |GLSL - eval| relative to max(|eval|, 1e-3 of the
 // model's peak over the pairs) (float32 arithmetic: where eval is tiny, its
@@ -65,39 +61,9 @@ double glsl_error(const Brdf& b, const fs::path& dir, bool all_targets) {
     const std::string err = bf_test::compile_glsl_all_targets(glsl, dir);
     CHECK(err.empty());
   }
-  const auto pr = pairs();
-  {
-    std::ofstream(dir / "model.glsl") << glsl;
-    std::ofstream d(dir / "dirs.txt");
-    d.precision(17);
-    for (const auto& [wi, wo] : pr)
-      d << wi.x() << " " << wi.y() << " " << wi.z() << " " << wo.x() << " " << wo.y() << " " << wo.z() << "\n";
-  }
-  INFO("GLSL runner " << runner().string() << " (built with the tests; needs Mesa's EGL: scripts/install-deps.sh)");
-  REQUIRE(fs::exists(runner()));
-  const std::string cmd = runner().string() + " " + (dir / "model.glsl").string() + " " +
-                          (dir / "dirs.txt").string() + " " + (dir / "out.txt").string() + " > " +
-                          (dir / "run.log").string() + " 2>&1";
-  const int rc = std::system(cmd.c_str());
-  INFO(bf_test::slurp((dir / "run.log").string()));
-  REQUIRE(rc == 0);
-  std::vector<Rgb> cpu;
-  double peak = 0.0;
-  for (const auto& [wi, wo] : pr) {
-    cpu.push_back(b.eval(wi, wo));
-    peak = std::max(peak, cpu.back().maxCoeff());
-  }
-  REQUIRE(peak > 0.0);
-  std::ifstream out(dir / "out.txt");
-  double worst = 0.0;
-  for (const Rgb& c : cpu) {
-    Rgb g;
-    REQUIRE(out >> g[0] >> g[1] >> g[2]);
-    REQUIRE(g.isFinite().all());
-    for (int ch = 0; ch < 3; ++ch)
-      worst = std::max(worst, std::abs(g[ch] - c[ch]) / std::max(std::abs(c[ch]), 1e-3 * peak));
-  }
-  return worst;
+  std::ofstream(dir / "model.glsl") << glsl;
+  return bf_test::glsl_run_error((dir / "model.glsl").string(), pairs(), {},
+                                 [&](const Vec3& wi, const Vec3& wo) { return b.eval(wi, wo); }, dir);
 }
 
 }  // namespace

@@ -2,6 +2,7 @@
 // product BRDFs (f = exp(a(P1 x) + b(P2 x) [+ c(P3 x')])): the search must end
 // near the floor, the error of `fit` at the true projections.
 #include <algorithm>
+#include <cmath>
 #include <random>
 
 #include "brdfs/catalogue.h"
@@ -105,25 +106,92 @@ TEST_CASE("structure: split_planes recovers the planes of block-diagonal Hessian
   }
 }
 
+TEST_CASE("structure: split_planes separates planes whose curvatures are alike") {
+  // Each Hessian comes with its twin whose blocks are swapped, so sum H^2 has
+  // every eigenvalue twice, once per plane: its eigenvectors may mix the
+  // planes arbitrarily, and no pairing of them is the true split. The
+  // random combinations of the Hessians must find it.
+  std::mt19937_64 rng(15);
+  std::uniform_real_distribution<double> U(-1, 1);
+  for (int trial = 0; trial < 5; ++trial) {
+    const Rotation4 R = Rotation4::random(rng);
+    const Eigen::Matrix4d Q = R.matrix();
+    std::vector<Eigen::Matrix4d> hs;
+    for (int k = 0; k < 100; ++k) {
+      Eigen::Matrix2d a, b;
+      a << 2 * U(rng), U(rng), 0, U(rng);
+      b << U(rng), 0.5 * U(rng), 0, 2 * U(rng);
+      a(1, 0) = a(0, 1);
+      b(1, 0) = b(0, 1);
+      for (int twin = 0; twin < 2; ++twin) {
+        Eigen::Matrix4d B = Eigen::Matrix4d::Zero();
+        B.block<2, 2>(0, 0) = twin ? b : a;
+        B.block<2, 2>(2, 2) = twin ? a : b;
+        hs.push_back(Q * B * Q.transpose());
+      }
+    }
+    const PlaneSplit s = split_planes(hs);
+    Mat24 A, Bp;
+    A << Q.col(0).transpose(), Q.col(1).transpose();
+    Bp << Q.col(2).transpose(), Q.col(3).transpose();
+    const double d = std::min(plane_distance(plane_of(s.first), A), plane_distance(plane_of(s.first), Bp));
+    INFO("trial " << trial << ": off-block " << s.off_block << ", distance to the nearer true plane " << d);
+    CHECK(d < 1e-5);
+    CHECK(s.off_block < 1e-8);
+  }
+}
+
+namespace {
+
+// The distances of the structured search's seed planes (the split of the
+// residual's Hessians at structure_radius) to the nearer true plane.
+std::pair<double, double> seed_distances(const PlantedProductBrdf& b, int grid, Parameterization p,
+                                         PlaneSplit* split = nullptr) {
+  const SampleSet s = sample_grid(b, grid);
+  const FitData d(s, 1e-5);
+  std::vector<double> y(d.size());
+  for (size_t k = 0; k < y.size(); ++k) y[k] = (d.g[0][k] + d.g[1][k] + d.g[2][k]) / 3;
+  StructureOptions so;
+  so.radius = structure_radius(d.size());
+  const PlaneSplit sp = split_planes(local_hessians(d.points(p), y, d.w, so));
+  if (split) *split = sp;
+  const Mat24 &A = b.terms()[0].P, &B = b.terms()[1].P;
+  return {std::min(plane_distance(plane_of(sp.first), A), plane_distance(plane_of(sp.first), B)),
+          std::min(plane_distance(plane_of(sp.second), A), plane_distance(plane_of(sp.second), B))};
+}
+
+}  // namespace
+
 TEST_CASE("structure: the seed planes of a planted two-plane BRDF are near the true ones") {
-  // Grid 10, both parameterizations: the Hessians are estimated, not exact,
-  // so the planes are only close (measured distances 0.002..0.03; bound 0.1).
+  // Grid 10, both parameterizations, members 0..7: the Hessians are estimated,
+  // not exact, so the planes are only close (measured distances 0.002..0.03;
+  // bound 0.1). At the fixed radius 0.35 members 2 and 3 (wiwo) got mixed
+  // planes (distance ~1); structure_radius(6,400 samples) is 0.55.
+  CHECK(structure_radius(43264) == Approx(0.35));
+  CHECK(structure_radius(6400) == Approx(0.35 * std::pow(40000.0 / 6400, 0.25)));
+  CHECK(structure_radius(10) == Approx(0.8));
   for (Parameterization p : {Parameterization::WiWo, Parameterization::HalfDiff}) {
-    for (int i = 0; i < 2; ++i) {
+    for (int i = 0; i < 8; ++i) {
       const PlantedProductBrdf b = planted_rotation_brdf(i, 2, p);
-      const SampleSet s = sample_grid(b, 10);
-      const FitData d(s, 1e-5);
-      std::vector<double> y(d.size());
-      for (size_t k = 0; k < y.size(); ++k) y[k] = d.g[0][k];
-      const PlaneSplit sp = split_planes(local_hessians(d.points(p), y, d.w, StructureOptions{}));
-      const Mat24 &A = b.terms()[0].P, &B = b.terms()[1].P;
-      const double d1 = std::min(plane_distance(plane_of(sp.first), A), plane_distance(plane_of(sp.first), B));
-      const double d2 = std::min(plane_distance(plane_of(sp.second), A), plane_distance(plane_of(sp.second), B));
+      PlaneSplit sp;
+      const auto [d1, d2] = seed_distances(b, 10, p, &sp);
       INFO(b.to_string() << ": distances " << d1 << ", " << d2 << ", off-block " << sp.off_block);
       CHECK(d1 < 0.1);
       CHECK(d2 < 0.1);
     }
   }
+}
+
+TEST_CASE("structure: the seed planes of planted member 12 (halfdiff, 16^4 grid) are the true ones") {
+  // The eigenvectors of sum H^2 mix its planes (off-block 0.077, distance 1
+  // before split_planes tried random combinations; measured now 0.001 and 0.000).
+  const PlantedProductBrdf b = planted_rotation_brdf(12, 2, Parameterization::HalfDiff);
+  PlaneSplit sp;
+  const auto [d1, d2] = seed_distances(b, 16, Parameterization::HalfDiff, &sp);
+  INFO(b.to_string() << ": distances " << d1 << ", " << d2 << ", off-block " << sp.off_block);
+  CHECK(d1 < 0.05);
+  CHECK(d2 < 0.05);
+  CHECK(sp.off_block < 0.01);
 }
 
 TEST_CASE("structured search: a planted two-plane BRDF ends near the floor, the greedy search does not") {
@@ -178,10 +246,12 @@ TEST_CASE("structured search: deterministic for a seed, whatever the thread coun
 
 TEST_CASE("structured search: planted family, both parameterizations, 2 and 3 terms", "[slow]") {
   // Grid 10, texture 8. Bounds: 2x the floor (2 terms) and 3x (3 terms), the
-  // issue's targets at texture 16 (measured here: docs/search.md).
+  // issue's targets at texture 16 (measured here: docs/search.md). Members 2
+  // and 3 (wiwo) ended at 2.4x and 4.7x the floor when the seeds' Hessians
+  // used the radius of a 16^4 grid on this sparser one (structure_radius).
   for (int terms : {2, 3})
     for (Parameterization p : {Parameterization::WiWo, Parameterization::HalfDiff})
-      for (int i = 0; i < 2; ++i) {
+      for (int i = 0; i < (terms == 2 ? 4 : 2); ++i) {
         const PlantedProductBrdf b = planted_rotation_brdf(i, terms, p);
         const SampleSet s = sample_grid(b, 10);
         const FitData d(s, 1e-5);
@@ -221,6 +291,22 @@ TEST_CASE("structured search: McCool's form is inside the search space and survi
     const Vec3 wo = from_spherical(std::acos(std::max(U(rng), 0.05)), 2 * M_PI * U(rng));
     const Rgb a = r.factorization->eval(wi, wo), c = g->eval(wi, wo);
     CHECK((a - c).cwiseAbs().maxCoeff() <= 1e-6 * std::max(1.0, a.cwiseAbs().maxCoeff()));
+  }
+}
+
+TEST_CASE("structured search: McCool's form, members 0-5, ends within 1.2x McCool's error", "[slow]") {
+  // Grid 10, texture 8; measured 0.89x-1.01x. Member 5 ended at 1.32x (and
+  // 9.0x on the 16^4 grid) before the fine polish of small searches: the
+  // planes were found but Powell's coarse line search stopped short of them.
+  for (int i = 0; i < 6; ++i) {
+    const PlantedProductBrdf b = planted_mccool_brdf(i);
+    const SampleSet s = sample_grid(b, 10);
+    const FitData d(s, 1e-5);
+    std::vector<double> em;
+    fit_homomorphic(d, mccool_terms(8), FitOptions{}, "mccool", &em);
+    const SearchResult r = search_factorization(d, structured(3, 8));
+    INFO(b.to_string() << ": McCool " << em.back() << ", structured " << r.rel_mse_after_term.back());
+    CHECK(r.rel_mse_after_term.back() <= 1.2 * em.back());
   }
 }
 
