@@ -66,7 +66,7 @@ struct FitOptions {
   bool clamp_log_range = true;
   // Dense: normal matrix assembled densely, LLT. Sparse: normal matrix assembled
   // directly in compressed columns, CHOLMOD supernodal LLT with AMD (SimplicialLLT without CHOLMOD).
-  // Auto: dense up to 1,100 unknowns (1,700 with 500,000 samples or more), sparse above (measured
+  // Auto: dense up to 1,300 unknowns (1,800 with 500,000 samples or more), sparse above (measured
   // crossovers, docs/speed.md "Sparse path"). ReferenceQR: the
   // simple path (dense B, Householder QR, no normal equations) for tests.
   enum class Solver { Auto, Dense, Sparse, ReferenceQR } solver = Solver::Auto;
