@@ -220,7 +220,7 @@ struct Workspace {
   std::vector<double> A;                    // normal matrix, M x M column-major
   std::vector<double> cells;                // per-cell sums of one lookup (kernels::cell_sums)
   std::vector<int> corners;                 // per lookup and cell: its 4 unknowns
-  std::array<std::vector<double>, 3> r;     // residual targets g - fixed, per channel
+  std::array<std::vector<double>, 3> r;     // residual targets g - fixed, per channel (both paths)
   std::vector<std::array<Lookups, 2>> own;  // lookups of the terms not in a prefix
   // Buffers above this many doubles (32 MB) are released after the fit.
   static constexpr size_t kKeep = size_t(4) << 20;
@@ -253,13 +253,39 @@ void scatter_cell_sums(const TermLayout& t, const double* cells, Eigen::Ref<Eige
   }
 }
 
-// The data part of the dense normal equations (lower triangle of A, rhs and
-// sum w r^2 per channel) for terms first_new.. and their products with the
+// The residual targets r_c = g_c - fixed_c of every valid sample, per channel.
+void residual_targets(const FitData& d, const std::array<std::vector<double>, 3>& fixed_values,
+                      std::array<std::vector<double>, 3>& r) {
+  for (int c = 0; c < 3; ++c) {
+    r[c].resize(d.size());
+    for (size_t k = 0; k < d.size(); ++k) r[c][k] = d.g[c][k] - fixed_values[c][k];
+  }
+}
+
+// sum_k w_k r_ck^2 per channel, each summed in sample order (one loop, three
+// independent chains).
+void weighted_square_sums(const FitData& d, const std::array<const double*, 3>& r, double out[3]) {
+  const double* w = d.w.data();
+  const double* r0 = r[0];
+  const double* r1 = r[1];
+  const double* r2 = r[2];
+  double s0 = 0, s1 = 0, s2 = 0;
+  for (size_t k = 0; k < d.size(); ++k) {
+    s0 += w[k] * r0[k] * r0[k];
+    s1 += w[k] * r1[k] * r1[k];
+    s2 += w[k] * r2[k] * r2[k];
+  }
+  out[0] = s0;
+  out[1] = s1;
+  out[2] = s2;
+}
+
+// The data part of the dense normal equations (lower triangle of A and rhs)
+// for terms first_new.. and their products with the
 // earlier terms; blocks among terms before first_new are left as they are (a
 // JointPrefix filled them). A's lower triangle (and, for reciprocal new terms,
 // their whole diagonal block) and rhs must be zero where they are assembled.
-// r: the residual targets g - fixed per channel. sum_wr2 (sum of w r^2 per
-// channel) is computed unless sum_wr2_known (a JointPrefix has it).
+// r: the residual targets g - fixed per channel (residual_targets).
 //
 // Each lookup (a term's projection, or a reciprocal term's conjugate) is
 // handled in its own pass over the samples, in sample order, so every matrix
@@ -274,29 +300,12 @@ void scatter_cell_sums(const TermLayout& t, const double* cells, Eigen::Ref<Eige
 void assemble_dense(const FitData& d, const std::array<const double*, 3>& r,
                     const std::vector<TermLayout>& terms,
                     const std::vector<const std::array<Lookups, 2>*>& lookups, size_t first_new,
-                    Eigen::Ref<Eigen::MatrixXd> A, Eigen::Ref<Eigen::MatrixXd> rhs, double sum_wr2[3],
-                    bool sum_wr2_known = false) {
+                    Eigen::Ref<Eigen::MatrixXd> A, Eigen::Ref<Eigen::MatrixXd> rhs) {
   const size_t N = d.size();
   const double* w = d.w.data();
   double* Ad = A.data();
   const size_t MM = static_cast<size_t>(A.outerStride());
   Workspace& ws = workspace();
-
-  if (!sum_wr2_known) {
-    // One loop, three independent chains (each channel summed in sample order).
-    double s0 = 0, s1 = 0, s2 = 0;
-    const double* r0 = r[0];
-    const double* r1 = r[1];
-    const double* r2 = r[2];
-    for (size_t k = 0; k < N; ++k) {
-      s0 += w[k] * r0[k] * r0[k];
-      s1 += w[k] * r1[k] * r1[k];
-      s2 += w[k] * r2[k] * r2[k];
-    }
-    sum_wr2[0] = s0;
-    sum_wr2[1] = s1;
-    sum_wr2[2] = s2;
-  }
 
   // Flattened lookup list: (term, half) pairs in order, with each lookup's
   // cell -> 4 unknowns table.
@@ -505,8 +514,8 @@ Prior extrapolation_prior(const FitData& d, const std::array<std::vector<double>
 // The least-squares objective (rel_mse, unclamped) read off the normal
 // equations at their solution Y (A Y = rhs): the data residual is
 // sum w r^2 - y.rhs - (the regularization's quadratic form at y), the latter
-// being ridge (reg_diag |y|^2), Laplacian (mu |L y|^2), gauge (gauge(c), the
-// path's own penalty) and prior (its rows w b b^T and w c b restored by
+// being ridge (reg_diag |y|^2), Laplacian (mu |L y|^2), gauge (gauge(c, reg)
+// adds the path's own penalty to reg) and prior (its rows w b b^T and w c b restored by
 // sum_r w_r ((b_r.y)^2 - 2 c_r (b_r.y)), plus the levels' energy).
 template <class Gauge>
 double objective_from_solution(const FitData& d, const std::vector<TermLayout>& terms, const Prior& prior,
@@ -521,7 +530,7 @@ double objective_from_solution(const FitData& d, const std::vector<TermLayout>& 
         for (int a2 = 0; a2 < n; ++a2) v += lv[a2] * Y(li[a2], c);
         reg += mu * v * v;
       });
-    reg += gauge(c);
+    gauge(c, reg);
     for (size_t pr = 0; pr < prior.rows(); ++pr) {
       const double by = prior.dot(pr, Y, c);
       reg += prior.w[pr] * by * (by - 2.0 * prior.target[pr][c]);
@@ -572,7 +581,6 @@ struct SparseWorkspace {
   std::vector<int> slot;                     // per cell of the later lookup: block slot or -1
   std::vector<int> slot_cell;                // per block slot: the later lookup's cell
   std::vector<double> blk;                   // per block slot: 16 sums
-  std::array<std::vector<double>, 3> r;      // residual targets g - fixed, per channel
 };
 
 SparseWorkspace& sparse_workspace() {
@@ -766,11 +774,10 @@ JointPrefix::JointPrefix(const FitData& d, const std::array<std::vector<double>,
   p.rhs = Eigen::MatrixXd::Zero(p.M, 3);
   std::vector<const std::array<Lookups, 2>*> lp;
   for (const auto& l : p.lookups) lp.push_back(&l);
-  for (int c = 0; c < 3; ++c) {
-    p.r[c].resize(d.size());
-    for (size_t k = 0; k < d.size(); ++k) p.r[c][k] = d.g[c][k] - fixed_values[c][k];
-  }
-  assemble_dense(d, {p.r[0].data(), p.r[1].data(), p.r[2].data()}, p.terms, lp, 0, p.A, p.rhs, p.sum_wr2);
+  residual_targets(d, fixed_values, p.r);
+  const std::array<const double*, 3> r = {p.r[0].data(), p.r[1].data(), p.r[2].data()};
+  weighted_square_sums(d, r, p.sum_wr2);
+  assemble_dense(d, r, p.terms, lp, 0, p.A, p.rhs);
 }
 
 JointPrefix::~JointPrefix() = default;
@@ -852,19 +859,23 @@ JointSolution solve_joint(const FitData& d, const std::array<std::vector<double>
   if (solver == FitOptions::Solver::Auto)
     solver = M <= (N >= 500000 ? 1800 : 1300) ? FitOptions::Solver::Dense : FitOptions::Solver::Sparse;
 
-  if (solver == FitOptions::Solver::Sparse) {
-    using SpMat = SparseUpper;
-    std::array<const double*, 3> r;
+  // Residual targets g - fixed (a prefix holds them) and, for the objective
+  // read off the normal equations, sum w r^2 per channel: both assembled paths.
+  std::array<const double*, 3> r{};
+  double sum_wr2[3] = {0, 0, 0};
+  if (solver != FitOptions::Solver::ReferenceQR) {
     if (K > 0) {
       for (int c = 0; c < 3; ++c) r[c] = prefix->impl().r[c].data();
+      std::copy_n(prefix->impl().sum_wr2, 3, sum_wr2);
     } else {
-      std::array<std::vector<double>, 3>& rr = sparse_workspace().r;
-      for (int c = 0; c < 3; ++c) {
-        rr[c].resize(N);
-        for (size_t k = 0; k < N; ++k) rr[c][k] = d.g[c][k] - fixed_values[c][k];
-        r[c] = rr[c].data();
-      }
+      residual_targets(d, fixed_values, workspace().r);
+      for (int c = 0; c < 3; ++c) r[c] = workspace().r[c].data();
+      if (!exact_error) weighted_square_sums(d, r, sum_wr2);
     }
+  }
+
+  if (solver == FitOptions::Solver::Sparse) {
+    using SpMat = SparseUpper;
     SpMat A;
     Eigen::MatrixXd rhs;
     assemble_sparse(d, r, terms, lookups, mu, prior, M, A, rhs);
@@ -906,17 +917,9 @@ JointSolution solve_joint(const FitData& d, const std::array<std::vector<double>
       // As the dense path: at the solution A y = rhs, so the data residual is
       // sum w r^2 - y.rhs - (regularization quadratic form at y); the gauge
       // here is the pinned texels' mean_diag y_i0^2.
-      double sum_wr2[3] = {0, 0, 0};
-      if (K > 0) {
-        for (int c = 0; c < 3; ++c) sum_wr2[c] = prefix->impl().sum_wr2[c];
-      } else {
-        for (size_t k = 0; k < N; ++k)
-          for (int c = 0; c < 3; ++c) sum_wr2[c] += d.w[k] * r[c][k] * r[c][k];
-      }
-      quad_rel_mse = objective_from_solution(d, terms, prior, Y, rhs, sum_wr2, mu, reg_diag, [&](int c) {
-        double g = 0;  // the pinned texels' mean_diag y_i0^2
-        for (size_t t = 1; t < terms.size(); ++t) g += mean_diag * Y(terms[t].first, c) * Y(terms[t].first, c);
-        return g;
+      quad_rel_mse = objective_from_solution(d, terms, prior, Y, rhs, sum_wr2, mu, reg_diag, [&](int c, double& reg) {
+        for (size_t t = 1; t < terms.size(); ++t)  // the pinned texels' mean_diag y_i0^2
+          reg += mean_diag * Y(terms[t].first, c) * Y(terms[t].first, c);
       });
     }
   } else if (solver == FitOptions::Solver::Dense) {
@@ -940,21 +943,8 @@ JointSolution solve_joint(const FitData& d, const std::array<std::vector<double>
         A.block(terms[ti].first, terms[ti].first, terms[ti].count, terms[ti].count)
             .triangularView<Eigen::StrictlyUpper>()
             .setZero();
-    std::array<const double*, 3> r;
-    if (K > 0) {
-      for (int c = 0; c < 3; ++c) r[c] = prefix->impl().r[c].data();
-    } else {
-      for (int c = 0; c < 3; ++c) {
-        ws.r[c].resize(N);
-        for (size_t k = 0; k < N; ++k) ws.r[c][k] = d.g[c][k] - fixed_values[c][k];
-        r[c] = ws.r[c].data();
-      }
-    }
     if (K > 0) rhs.topRows(pM) = prefix->impl().rhs;
-    double sum_wr2[3];
-    if (K > 0)
-      for (int c = 0; c < 3; ++c) sum_wr2[c] = prefix->impl().sum_wr2[c];
-    assemble_dense(d, r, terms, lookups, K, A, rhs, sum_wr2, K > 0);
+    assemble_dense(d, r, terms, lookups, K, A, rhs);
     double reg_diag = 0;  // Laplacian, gauge and ridge go into A; remember them for the objective
     for (const TermLayout& t : terms)
       laplacian_rows(t, [&](const int* li, const double* lv, int n) {
@@ -988,13 +978,11 @@ JointSolution solve_joint(const FitData& d, const std::array<std::vector<double>
     if (!exact_error) {
       // At the solution A y = rhs, so the data residual is
       // sum w r^2 - y.rhs - (regularization quadratic form at y).
-      quad_rel_mse = objective_from_solution(d, terms, prior, Y, rhs, sum_wr2, mu, reg_diag, [&](int c) {
-        double g = 0;  // gamma (sum of the term's texels)^2 per later joint term
-        for (size_t t = 1; t < terms.size(); ++t) {
+      quad_rel_mse = objective_from_solution(d, terms, prior, Y, rhs, sum_wr2, mu, reg_diag, [&](int c, double& reg) {
+        for (size_t t = 1; t < terms.size(); ++t) {  // gamma (sum of the term's texels)^2
           const double sum = Y.col(c).segment(terms[t].first, terms[t].count).sum();
-          g += mean_diag / terms[t].count * sum * sum;
+          reg += mean_diag / terms[t].count * sum * sum;
         }
-        return g;
       });
     }
   } else {
@@ -1121,8 +1109,7 @@ Eigen::MatrixXd joint_normal_matrix(const FitData& d, const std::vector<TermSpec
   if (unknowns) *unknowns = static_cast<size_t>(M);
   if (static_cast<size_t>(M) > max_unknowns) return Eigen::MatrixXd();
   Eigen::MatrixXd A = Eigen::MatrixXd::Zero(M, M), rhs = Eigen::MatrixXd::Zero(M, 3);
-  double sum_wr2[3];
-  assemble_dense(d, {d.g[0].data(), d.g[1].data(), d.g[2].data()}, terms, lookups, 0, A, rhs, sum_wr2);
+  assemble_dense(d, {d.g[0].data(), d.g[1].data(), d.g[2].data()}, terms, lookups, 0, A, rhs);
   const double mu = opt.smoothing * d.W / std::max(M, 1);
   for (const TermLayout& t : terms)
     laplacian_rows(t, [&](const int* li, const double* lv, int n) {
