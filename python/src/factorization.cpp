@@ -38,16 +38,22 @@ std::shared_ptr<PyFactorization> wrap(FactorizationPtr f) {
 
 namespace {
 
+// metrics (docs/design.md §4) of `approx` on `s` as a dict, computed without
+// the GIL.
+py::dict score_dict(const Brdf& approx, const SampleSet& s, double eps) {
+  Metrics mt;
+  {
+    py::gil_scoped_release release;
+    mt = evaluate_metrics(approx, s, LogTransform::of(s, eps));
+  }
+  return metrics_dict(mt);
+}
+
 // The module functions score() and load().
 void bind_score_and_load(py::module_& m) {
   m.def(
       "score",
-      [](const PyBrdf& approx, const SampleSet& s, double eps) {
-        py::gil_scoped_release release;
-        const Metrics mt = evaluate_metrics(*approx.brdf, s, LogTransform::of(s, eps));
-        py::gil_scoped_acquire gil;
-        return metrics_dict(mt);
-      },
+      [](const PyBrdf& approx, const SampleSet& s, double eps) { return score_dict(*approx.brdf, s, eps); },
       py::arg("approx"), py::arg("samples"), py::arg("metric_eps") = 1e-5,
       "Metrics (docs/design.md §4) of any BRDF (a factorization, a model, a reloaded export) on a sample set.");
   m.def(
@@ -118,12 +124,7 @@ and exports.)doc")
            "Everything needed to rebuild it, as in the export sidecar (dict).")
       .def(
           "score",
-          [](const PyFactorization& f, const SampleSet& s, double eps) {
-            py::gil_scoped_release release;
-            const Metrics mt = evaluate_metrics(*f.f, s, LogTransform::of(s, eps));
-            py::gil_scoped_acquire gil;
-            return metrics_dict(mt);
-          },
+          [](const PyFactorization& f, const SampleSet& s, double eps) { return score_dict(*f.f, s, eps); },
           py::arg("samples"), py::arg("metric_eps") = 1e-5,
           "Metrics (docs/design.md §4) of this approximation on any sample set.")
       .def(
