@@ -28,21 +28,24 @@ TEST_CASE("dense kernels: every supported variant solves an SPD system like Eige
   bool active_listed = false;
   for (const std::string& v : variants) active_listed |= v == kernels::active_variant();
   CHECK(active_listed);
-  // Sizes below, at and above Eigen's LLT block size (the blocked path).
-  for (int n : {1, 7, 64, 300}) {
-    const Eigen::MatrixXd A = random_spd(n, 17u + n);
-    Eigen::MatrixXd B = Eigen::MatrixXd::Random(n, 3);
-    const Eigen::MatrixXd ref = A.llt().solve(B);
-    for (const std::string& v : variants) {
-      INFO("variant " << v << ", n = " << n);
-      Eigen::MatrixXd a = A;
-      a.triangularView<Eigen::StrictlyUpper>().setConstant(1e300);  // only the lower triangle is read
-      Eigen::MatrixXd x = B;
-      REQUIRE(kernels::llt_solve_with(v, a.data(), n, x.data(), 3));
-      CHECK((x - ref).norm() <= 1e-12 * ref.norm());
-      CHECK((A * x - B).norm() <= 1e-10 * B.norm());
+  // Sizes below, at and above the LLT's block of 48 columns (one block, a
+  // whole number of blocks, a remainder); 3 right-hand sides (the fit's
+  // channels, a kernel of its own) and other counts (Eigen's solves).
+  for (int n : {1, 7, 48, 64, 97, 300})
+    for (int nrhs : {1, 3, 5}) {
+      const Eigen::MatrixXd A = random_spd(n, 17u + n);
+      Eigen::MatrixXd B = Eigen::MatrixXd::Random(n, nrhs);
+      const Eigen::MatrixXd ref = A.llt().solve(B);
+      for (const std::string& v : variants) {
+        INFO("variant " << v << ", n = " << n << ", right-hand sides " << nrhs);
+        Eigen::MatrixXd a = A;
+        a.triangularView<Eigen::StrictlyUpper>().setConstant(1e300);  // only the lower triangle is read
+        Eigen::MatrixXd x = B;
+        REQUIRE(kernels::llt_solve_with(v, a.data(), n, x.data(), nrhs));
+        CHECK((x - ref).norm() <= 1e-12 * ref.norm());
+        CHECK((A * x - B).norm() <= 1e-10 * B.norm());
+      }
     }
-  }
 }
 
 TEST_CASE("dense kernels: a matrix that is not positive definite is reported, not solved") {
@@ -80,23 +83,28 @@ Eigen::MatrixXd banded_head_spd(int n, int n1, int bw, unsigned seed) {
 
 TEST_CASE("dense kernels: the banded-head Cholesky solves like Eigen's LLT, for every variant") {
   // (n, n1, bw): band used (4 bw <= n1), a full band (falls back), the head
-  // being everything but one unknown, a band of width 0.
-  const int cases[][3] = {{60, 30, 5}, {300, 150, 20}, {100, 40, 30}, {50, 49, 3}, {40, 20, 0}};
-  for (const auto& c : cases) {
-    const int n = c[0], n1 = c[1], bw = c[2];
-    const Eigen::MatrixXd A = banded_head_spd(n, n1, bw, 7u + n + bw);
-    const Eigen::MatrixXd B = Eigen::MatrixXd::Random(n, 3);
-    const Eigen::MatrixXd ref = A.llt().solve(B);
-    for (const std::string& v : kernels::supported_variants()) {
-      INFO("variant " << v << ", n = " << n << ", n1 = " << n1 << ", bw = " << bw);
-      Eigen::MatrixXd a = A;
-      a.triangularView<Eigen::StrictlyUpper>().setConstant(1e300);  // only the lower triangle is read
-      Eigen::MatrixXd x = B;
-      REQUIRE(kernels::llt_solve_banded_head_with(v, a.data(), n, n1, x.data(), 3));
-      CHECK((x - ref).norm() <= 1e-12 * ref.norm());
-      CHECK((A * x - B).norm() <= 1e-10 * B.norm());
+  // being everything but one unknown, a band of width 0; head sizes that are
+  // and are not multiples of the 4-column blocks of L21, tails of 8 rows, 4
+  // rows and single rows.
+  const int cases[][3] = {{60, 30, 5}, {300, 150, 20}, {100, 40, 30}, {50, 49, 3}, {40, 20, 0},
+                          {442, 221, 17}, {103, 64, 16}, {77, 33, 1}};
+  for (const auto& c : cases)
+    for (int nrhs : {1, 3, 4}) {
+      const int n = c[0], n1 = c[1], bw = c[2];
+      const Eigen::MatrixXd A = banded_head_spd(n, n1, bw, 7u + n + bw);
+      const Eigen::MatrixXd B = Eigen::MatrixXd::Random(n, nrhs);
+      const Eigen::MatrixXd ref = A.llt().solve(B);
+      for (const std::string& v : kernels::supported_variants()) {
+        INFO("variant " << v << ", n = " << n << ", n1 = " << n1 << ", bw = " << bw << ", right-hand sides "
+                        << nrhs);
+        Eigen::MatrixXd a = A;
+        a.triangularView<Eigen::StrictlyUpper>().setConstant(1e300);  // only the lower triangle is read
+        Eigen::MatrixXd x = B;
+        REQUIRE(kernels::llt_solve_banded_head_with(v, a.data(), n, n1, x.data(), nrhs));
+        CHECK((x - ref).norm() <= 1e-12 * ref.norm());
+        CHECK((A * x - B).norm() <= 1e-10 * B.norm());
+      }
     }
-  }
 }
 
 TEST_CASE("dense kernels: the banded-head Cholesky reports a matrix that is not positive definite") {
