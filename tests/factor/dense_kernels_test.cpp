@@ -107,6 +107,53 @@ TEST_CASE("dense kernels: the banded-head Cholesky solves like Eigen's LLT, for 
     }
 }
 
+namespace {
+// As banded_head_spd, but each tail row couples only to head columns from a
+// random first one on (a third of the rows to none): the staircase the
+// kernel orders the tail by (a fit's cross block is sparse this way).
+Eigen::MatrixXd staircase_spd(int n, int n1, int bw, unsigned seed) {
+  Eigen::MatrixXd A = banded_head_spd(n, n1, bw, seed);
+  std::mt19937 rng(seed + 1);
+  std::uniform_int_distribution<int> first(0, n1 + n1 / 2);  // > n1 - 1: no coupling
+  for (int i = n1; i < n; ++i) {
+    const int f = first(rng);
+    for (int k = 0; k < std::min(f, n1); ++k) A(i, k) = A(k, i) = 0.0;
+  }
+  return A;
+}
+}  // namespace
+
+TEST_CASE("dense kernels: the banded-head Cholesky with a staircase coupling solves like Eigen's LLT") {
+  // Tail rows reordered by their first coupled head column, rows with none
+  // skipped; tail sizes around the 8- and 4-row chunks and the 32-row blocks
+  // of the Schur update.
+  const int cases[][3] = {{442, 221, 17}, {90, 60, 6}, {133, 64, 8}, {41, 20, 2}, {300, 100, 10}};
+  for (const auto& c : cases)
+    for (int nrhs : {3, 2}) {
+      const int n = c[0], n1 = c[1], bw = c[2];
+      const Eigen::MatrixXd A = staircase_spd(n, n1, bw, 5u + n);
+      const Eigen::MatrixXd B = Eigen::MatrixXd::Random(n, nrhs);
+      const Eigen::MatrixXd ref = A.llt().solve(B);
+      for (const std::string& v : kernels::supported_variants()) {
+        INFO("variant " << v << ", n = " << n << ", n1 = " << n1 << ", right-hand sides " << nrhs);
+        Eigen::MatrixXd a = A;
+        a.triangularView<Eigen::StrictlyUpper>().setConstant(1e300);
+        Eigen::MatrixXd x = B;
+        REQUIRE(kernels::llt_solve_banded_head_with(v, a.data(), n, n1, x.data(), nrhs));
+        CHECK((x - ref).norm() <= 1e-12 * ref.norm());
+        CHECK((A * x - B).norm() <= 1e-10 * B.norm());
+      }
+    }
+  // No coupling at all: the tail is solved on its own.
+  Eigen::MatrixXd A = banded_head_spd(80, 40, 4, 3u);
+  A.block(40, 0, 40, 40).setZero();
+  A.block(0, 40, 40, 40).setZero();
+  const Eigen::MatrixXd B = Eigen::MatrixXd::Random(80, 3);
+  Eigen::MatrixXd a = A, x = B;
+  REQUIRE(kernels::llt_solve_banded_head(a.data(), 80, 40, x.data(), 3));
+  CHECK((A * x - B).norm() <= 1e-10 * B.norm());
+}
+
 TEST_CASE("dense kernels: the banded-head Cholesky reports a matrix that is not positive definite") {
   // Once in the banded head, once in the Schur complement.
   for (int bad : {10, 45}) {
