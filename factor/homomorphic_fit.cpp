@@ -14,6 +14,7 @@
 #include <dlfcn.h>
 #endif
 #include <algorithm>
+#include <cstring>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -262,22 +263,57 @@ void residual_targets(const FitData& d, const std::array<std::vector<double>, 3>
   }
 }
 
-// sum_k w_k r_ck^2 per channel, each summed in sample order (one loop, three
-// independent chains).
+// True when every fixed value is +-0 (no fixed term: the residual targets are
+// g itself and need no copy). The bits below the sign are or-ed over blocks
+// of 256 values (integer operations: vectorized), stopping at the first
+// block with a nonzero.
+bool all_zero(const std::array<std::vector<double>, 3>& fixed_values) {
+  constexpr uint64_t kNoSign = ~(uint64_t(1) << 63);
+  for (const std::vector<double>& v : fixed_values) {
+    const size_t n = v.size();
+    for (size_t k = 0; k < n; k += 256) {
+      const size_t e = std::min(n, k + 256);
+      uint64_t bits = 0;
+      for (size_t i = k; i < e; ++i) {
+        uint64_t b;
+        std::memcpy(&b, &v[i], sizeof b);
+        bits |= b & kNoSign;
+      }
+      if (bits != 0) return false;
+    }
+  }
+  return true;
+}
+
+// sum_k w_k r_ck^2 per channel, in one pass: 4 interleaved partial sums per
+// channel (sample k into k mod 4), added pairwise at the end.
 void weighted_square_sums(const FitData& d, const std::array<const double*, 3>& r, double out[3]) {
+  typedef double v4 __attribute__((vector_size(32)));
   const double* w = d.w.data();
+  const size_t n = d.size();
   const double* r0 = r[0];
   const double* r1 = r[1];
   const double* r2 = r[2];
-  double s0 = 0, s1 = 0, s2 = 0;
-  for (size_t k = 0; k < d.size(); ++k) {
-    s0 += w[k] * r0[k] * r0[k];
-    s1 += w[k] * r1[k] * r1[k];
-    s2 += w[k] * r2[k] * r2[k];
+  v4 s0 = {0, 0, 0, 0}, s1 = s0, s2 = s0;
+  size_t k = 0;
+  for (; k + 4 <= n; k += 4) {
+    v4 wk, a, b, c;
+    std::memcpy(&wk, w + k, sizeof wk);
+    std::memcpy(&a, r0 + k, sizeof a);
+    std::memcpy(&b, r1 + k, sizeof b);
+    std::memcpy(&c, r2 + k, sizeof c);
+    s0 += wk * a * a;
+    s1 += wk * b * b;
+    s2 += wk * c * c;
   }
-  out[0] = s0;
-  out[1] = s1;
-  out[2] = s2;
+  for (; k < n; ++k) {
+    s0[k & 3] += w[k] * r0[k] * r0[k];
+    s1[k & 3] += w[k] * r1[k] * r1[k];
+    s2[k & 3] += w[k] * r2[k] * r2[k];
+  }
+  out[0] = (s0[0] + s0[1]) + (s0[2] + s0[3]);
+  out[1] = (s1[0] + s1[1]) + (s1[2] + s1[3]);
+  out[2] = (s2[0] + s2[1]) + (s2[2] + s2[3]);
 }
 
 // The data part of the dense normal equations (lower triangle of A and rhs)
@@ -868,8 +904,12 @@ JointSolution solve_joint(const FitData& d, const std::array<std::vector<double>
       for (int c = 0; c < 3; ++c) r[c] = prefix->impl().r[c].data();
       std::copy_n(prefix->impl().sum_wr2, 3, sum_wr2);
     } else {
-      residual_targets(d, fixed_values, workspace().r);
-      for (int c = 0; c < 3; ++c) r[c] = workspace().r[c].data();
+      if (all_zero(fixed_values)) {
+        for (int c = 0; c < 3; ++c) r[c] = d.g[c].data();
+      } else {
+        residual_targets(d, fixed_values, workspace().r);
+        for (int c = 0; c < 3; ++c) r[c] = workspace().r[c].data();
+      }
       if (!exact_error) weighted_square_sums(d, r, sum_wr2);
     }
   }
