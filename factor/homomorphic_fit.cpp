@@ -51,6 +51,8 @@ FitData::FitData(const SampleSet& s, double eps) {
     for (int c = 0; c < 3; ++c) g[c].push_back(transform.g(c, s.value[k][c]));
   }
   if (!(W > 0.0)) throw std::invalid_argument("fit: the valid samples' weights sum to 0");
+  for (int c = 0; c < 3; ++c)
+    for (size_t k = 0; k < w.size(); ++k) wg2[c] += w[k] * g[c][k] * g[c][k];
   for (int c = 0; c < 3; ++c) {
     const auto [lo, hi] = std::minmax_element(g[c].begin(), g[c].end());
     log_range[c] = {*lo, *hi};
@@ -904,13 +906,16 @@ JointSolution solve_joint(const FitData& d, const std::array<std::vector<double>
       for (int c = 0; c < 3; ++c) r[c] = prefix->impl().r[c].data();
       std::copy_n(prefix->impl().sum_wr2, 3, sum_wr2);
     } else {
-      if (all_zero(fixed_values)) {
-        for (int c = 0; c < 3; ++c) r[c] = d.g[c].data();
+      if (all_zero(fixed_values)) {  // r = g, sum w r^2 = FitData::wg2
+        for (int c = 0; c < 3; ++c) {
+          r[c] = d.g[c].data();
+          sum_wr2[c] = d.wg2[c];
+        }
       } else {
         residual_targets(d, fixed_values, workspace().r);
         for (int c = 0; c < 3; ++c) r[c] = workspace().r[c].data();
+        if (!exact_error) weighted_square_sums(d, r, sum_wr2);
       }
-      if (!exact_error) weighted_square_sums(d, r, sum_wr2);
     }
   }
 

@@ -94,6 +94,9 @@ class FitData {
   std::vector<double> w;                 // weight per valid sample
   double W = 0;                          // sum of w
   std::array<std::vector<double>, 3> g;  // log-space target per channel
+  // Per channel sum of w g_c^2 (like W, set by the constructor): the fit's
+  // objective with no fixed term starts from it.
+  std::array<double, 3> wg2{};
   // Per channel [min g_c, max g_c] over the valid samples (the log-range clamp).
   LogRange log_range{};
   // clamp(s, log_range[c]) if opt.clamp_log_range, else s.

@@ -76,13 +76,13 @@ double hull_distance(const std::vector<Eigen::Vector2d>& hull, const Eigen::Vect
   const size_t n = hull.size();
   if (n >= 3) {
     bool inside = true;
-    for (size_t i = 0; i < n && inside; ++i) inside = cross2(hull[i], hull[(i + 1) % n], p) >= 0;
+    for (size_t i = 0; i < n && inside; ++i) inside = cross2(hull[i], hull[i + 1 == n ? 0 : i + 1], p) >= 0;
     if (inside) return 0.0;
   }
   double best = 1e300;
   for (size_t i = 0; i < n; ++i) {
     const Eigen::Vector2d& a = hull[i];
-    const Eigen::Vector2d& b = hull[(i + 1) % n];
+    const Eigen::Vector2d& b = hull[i + 1 == n ? 0 : i + 1];
     const Eigen::Vector2d ab = b - a;
     const double t = std::clamp((p - a).dot(ab) / std::max(ab.squaredNorm(), 1e-300), 0.0, 1.0);
     best = std::min(best, (a + t * ab - p).squaredNorm());
