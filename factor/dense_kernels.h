@@ -25,10 +25,13 @@ bool llt_solve(double* A, long n, double* B, long nrhs);
 
 // llt_solve for a matrix whose leading n1 x n1 block is banded (the fit's first
 // joint term: bilinear cells and Laplacian couple texels at most 2 rows apart).
-// That block is factored in band storage order, the n - n1 trailing unknowns
-// through the Schur complement A22 - L21 L21^T (dense). The same factorization
-// as llt_solve up to rounding; falls back to llt_solve when the head's
-// bandwidth exceeds n1 / 4 or n1 is 0 or n.
+// That block is factored in its band, the n - n1 trailing unknowns through the
+// Schur complement A22 - L21 L21^T, with the trailing unknowns ordered by their
+// first coupled head column (a row of L21 is zero before it, and the fit's
+// coupling block is sparse: the products skip that staircase; the solution
+// comes back in the original order). The same factorization as llt_solve up
+// to rounding; falls back to llt_solve when the head's bandwidth exceeds
+// n1 / 4 or n1 is 0 or n. Scratch memory is kept per thread.
 bool llt_solve_banded_head(double* A, long n, long n1, double* B, long nrhs);
 
 // The variant llt_solve uses: "generic", "avx2" (AVX2 + FMA) or "avx512"
