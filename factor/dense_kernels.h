@@ -30,8 +30,9 @@ bool llt_solve(double* A, long n, double* B, long nrhs);
 // first coupled head column (a row of L21 is zero before it, and the fit's
 // coupling block is sparse: the products skip that staircase; the solution
 // comes back in the original order). The same factorization as llt_solve up
-// to rounding; falls back to llt_solve when the head's bandwidth exceeds
-// n1 / 4 or n1 is 0 or n. Scratch memory is kept per thread.
+// to rounding; with n1 = n a banded Cholesky of the whole matrix; falls back to
+// llt_solve when the head's bandwidth exceeds n1 / 4 or n1 is 0. Scratch
+// memory is kept per thread.
 bool llt_solve_banded_head(double* A, long n, long n1, double* B, long nrhs);
 
 // The variant llt_solve uses: "generic", "avx2" (AVX2 + FMA) or "avx512"

@@ -1012,8 +1012,9 @@ JointSolution solve_joint(const FitData& d, const std::array<std::vector<double>
     // The first joint term's own block is banded (a sample couples the 4
     // corners of its cell, the Laplacian texels two rows apart) unless the
     // term is reciprocal (its conjugate lookups couple distant texels) or the
-    // extrapolation prior's level rows couple a term's unreached texels.
-    const bool banded_head = terms.size() > 1 && !terms[0].reciprocal && !prior.on();
+    // extrapolation prior's level rows couple a term's unreached texels. (A
+    // single term is all head: a banded solve.)
+    const bool banded_head = !terms[0].reciprocal && !prior.on();
     const bool pd = banded_head ? kernels::llt_solve_banded_head(A.data(), M, terms[0].count, Y.data(), 3)
                                 : kernels::llt_solve(A.data(), M, Y.data(), 3);
     ws.trim();

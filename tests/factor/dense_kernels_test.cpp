@@ -83,11 +83,12 @@ Eigen::MatrixXd banded_head_spd(int n, int n1, int bw, unsigned seed) {
 
 TEST_CASE("dense kernels: the banded-head Cholesky solves like Eigen's LLT, for every variant") {
   // (n, n1, bw): band used (4 bw <= n1), a full band (falls back), the head
-  // being everything but one unknown, a band of width 0; head sizes that are
+  // being everything but one unknown or everything (a banded matrix), a band
+  // of width 0; head sizes that are
   // and are not multiples of the 4-column blocks of L21, tails of 8 rows, 4
   // rows and single rows.
   const int cases[][3] = {{60, 30, 5}, {300, 150, 20}, {100, 40, 30}, {50, 49, 3}, {40, 20, 0},
-                          {442, 221, 17}, {103, 64, 16}, {77, 33, 1}};
+                          {442, 221, 17}, {103, 64, 16}, {77, 33, 1}, {221, 221, 17}, {30, 30, 2}};
   for (const auto& c : cases)
     for (int nrhs : {1, 3, 4}) {
       const int n = c[0], n1 = c[1], bw = c[2];
