@@ -10,7 +10,7 @@
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
 #ifdef BF_FACTOR_CHOLMOD
-#include <Eigen/CholmodSupport>
+#include <cholmod.h>
 #include <dlfcn.h>
 #endif
 #include <algorithm>
@@ -735,6 +735,270 @@ void assemble_sparse(const FitData& d, const std::array<const double*, 3>& r,
   if (trip.capacity() > (size_t(4) << 20)) std::vector<Eigen::Triplet<double>>().swap(trip);
 }
 
+// The sparse normal matrix in compressed columns (upper triangle: column j
+// holds rows i <= j, sorted, its diagonal entry always stored, hence last).
+struct Csc {
+  std::vector<int> p;     // M + 1 column starts
+  std::vector<int> i;     // row of each entry
+  std::vector<double> x;  // value of each entry
+};
+
+// Buffers of the column-by-column assembly (assemble_sparse_csc), one set per
+// thread, reused across fits so that a search's fits do not allocate them
+// again; nothing is carried from one fit to the next.
+struct CscWorkspace {
+  std::vector<double> cells;     // every lookup's per-cell sums (kernels::cell_sums), one after another
+  std::vector<int> start;        // bucket starts (cells + 1) of the current term's lookups
+  std::vector<int> next;         // bucket fill positions
+  std::vector<double> rec;       // the current term's lookups' samples, bucketed by the lookup's
+                                 // cell: w, fa, fb, then (fa, fb) of each other lookup
+  std::vector<int> rec_cell;     // the same samples: the other lookups' cells
+  std::vector<double> acc;       // the column being assembled, by row (M)
+  std::vector<uint64_t> bits;    // its rows that received a value
+  std::vector<int> prior_start;  // per unknown (M + 1): its entries in the prior's rows ...
+  std::vector<int> prior_entry;  // ... as indices into Prior::idx
+  std::vector<int> prior_row;    // ... and their rows
+  std::vector<int> level_of;     // per unknown: its Prior::levels index, or -1
+  Csc A;
+};
+
+CscWorkspace& csc_workspace() {
+  thread_local CscWorkspace ws;
+  return ws;
+}
+
+// The sparse path's normal equations A y = rhs without the gauge and ridge:
+// the same as assemble_sparse up to summation order, assembled column by
+// column straight into compressed storage (no triplets, no sort). Column j, a
+// texel of term t, receives (rows <= j only):
+//  - the self products of each of t's lookups from the per-cell sums
+//    (kernels::cell_sums) of the up to 4 cells having j as a corner, and j's
+//    right-hand side from the same cells;
+//  - the cross products with the lookups of earlier terms and with t's other
+//    lookup (reciprocal): each of t's lookups has its samples bucketed by its
+//    cell (counting sort, sample order kept) together with the other lookups'
+//    cells and fractions; over the samples of j's cells, w b_j (the sample's
+//    weight at j) times the other lookup's 4 corner weights;
+//  - mu L^T L (the Laplacian rows of j and of its neighbours), the prior's
+//    rows through j and j's prior level.
+// A column's rows are summed in a dense accumulator with a bitset of the rows
+// set, read back in row order.
+void assemble_sparse_csc(const FitData& d, const std::array<const double*, 3>& r,
+                         const std::vector<TermLayout>& terms,
+                         const std::vector<const std::array<Lookups, 2>*>& lookups, double mu,
+                         const Prior& prior, int M, Csc& A, Eigen::MatrixXd& rhs) {
+  const size_t N = d.size();
+  const double* w = d.w.data();
+  CscWorkspace& ws = csc_workspace();
+  rhs.setZero(M, 3);
+
+  struct Sub {
+    int term;
+    const Lookups* lk;
+    size_t cells;             // offset into ws.cells
+    std::vector<int> others;  // lookups of earlier terms and this term's other lookup
+    size_t start = 0, rec = 0, rec_cell = 0;  // offsets, while its term is assembled
+  };
+  std::vector<Sub> subs;
+  size_t ncells = 0;
+  for (size_t ti = 0; ti < terms.size(); ++ti)
+    for (int h = 0; h < (terms[ti].reciprocal ? 2 : 1); ++h) {
+      subs.push_back({int(ti), &(*lookups[ti])[h], ncells, {}});
+      ncells += size_t(terms[ti].proj.res) * terms[ti].proj.res * kernels::kCellDoubles;
+    }
+  for (size_t s = 0; s < subs.size(); ++s)
+    for (size_t o = 0; o < subs.size(); ++o)
+      if (o != s && subs[o].term <= subs[s].term) subs[s].others.push_back(int(o));
+  ws.cells.assign(ncells, 0.0);
+  for (const Sub& s : subs)
+    kernels::cell_sums(N, s.lk->cell.data(), s.lk->fa.data(), s.lk->fb.data(), w, r[0], r[1], r[2],
+                       ws.cells.data() + s.cells);
+
+  // The prior: per unknown, its entries in the prior's rows, and its level.
+  const bool has_rows = prior.rows() > 0;
+  if (has_rows) {
+    ws.prior_start.assign(size_t(M) + 1, 0);
+    for (const int u : prior.idx) ++ws.prior_start[u + 1];
+    for (int u = 0; u < M; ++u) ws.prior_start[u + 1] += ws.prior_start[u];
+    ws.prior_entry.resize(prior.idx.size());
+    ws.prior_row.resize(prior.idx.size());
+    ws.next.assign(ws.prior_start.begin(), ws.prior_start.end() - 1);
+    for (size_t pr = 0; pr < prior.rows(); ++pr)
+      for (int e = prior.start[pr]; e < prior.start[pr + 1]; ++e) {
+        const int at = ws.next[prior.idx[e]]++;
+        ws.prior_entry[at] = e;
+        ws.prior_row[at] = static_cast<int>(pr);
+      }
+  }
+  const bool has_levels = !prior.levels.empty();
+  if (has_levels) {
+    ws.level_of.assign(M, -1);
+    for (size_t l = 0; l < prior.levels.size(); ++l)
+      for (const int u : prior.levels[l].idx) ws.level_of[u] = static_cast<int>(l);
+  }
+
+  ws.acc.assign(M, 0.0);
+  ws.bits.assign((size_t(M) + 63) / 64, 0);
+  double* acc = ws.acc.data();
+  uint64_t* bits = ws.bits.data();
+  const auto add = [acc, bits](int row, double v) {
+    acc[row] += v;
+    bits[row >> 6] |= uint64_t(1) << (row & 63);
+  };
+  A.p.resize(size_t(M) + 1);
+  A.i.clear();
+  A.x.clear();
+  A.p[0] = 0;
+  for (size_t ti = 0; ti < terms.size(); ++ti) {
+    const TermLayout& t = terms[ti];
+    const int R = t.proj.res;
+    const int* unk = t.unk.data();
+
+    // Bucket the samples by the cell of each of this term's lookups that has others.
+    size_t nstart = 0, nrec = 0, nrec_cell = 0;
+    for (Sub& s : subs) {
+      if (s.term != int(ti) || s.others.empty()) continue;
+      s.start = nstart;
+      s.rec = nrec;
+      s.rec_cell = nrec_cell;
+      nstart += size_t(R) * R + 1;
+      nrec += N * (3 + 2 * s.others.size());
+      nrec_cell += N * s.others.size();
+    }
+    ws.start.assign(nstart, 0);
+    ws.rec.resize(nrec);
+    ws.rec_cell.resize(nrec_cell);
+    for (const Sub& s : subs) {
+      if (s.term != int(ti) || s.others.empty()) continue;
+      int* start = ws.start.data() + s.start;
+      const int* cell = s.lk->cell.data();
+      for (size_t k = 0; k < N; ++k) ++start[cell[k] + 1];
+      for (int c = 0; c < R * R; ++c) start[c + 1] += start[c];
+      ws.next.assign(start, start + size_t(R) * R);
+      const size_t no = s.others.size(), sd = 3 + 2 * no;
+      double* rec = ws.rec.data() + s.rec;
+      int* rec_cell = ws.rec_cell.data() + s.rec_cell;
+      const double* fa = s.lk->fa.data();
+      const double* fb = s.lk->fb.data();
+      for (size_t k = 0; k < N; ++k) {
+        const size_t e = static_cast<size_t>(ws.next[cell[k]]++);
+        double* rd = rec + e * sd;
+        rd[0] = w[k];
+        rd[1] = fa[k];
+        rd[2] = fb[k];
+        for (size_t o = 0; o < no; ++o) {
+          const Lookups& lo = *subs[s.others[o]].lk;
+          rd[3 + 2 * o] = lo.fa[k];
+          rd[4 + 2 * o] = lo.fb[k];
+          rec_cell[e * no + o] = lo.cell[k];
+        }
+      }
+    }
+
+    // The Laplacian's neighbours of a texel: texels of the mask, left, right, below, above.
+    const auto nbrs = [&](int tex, int* out) {
+      const int tx = tex % R, ty = tex / R;
+      int n = 0;
+      if (tx > 0 && unk[tex - 1] >= 0) out[n++] = tex - 1;
+      if (tx < R - 1 && unk[tex + 1] >= 0) out[n++] = tex + 1;
+      if (ty > 0 && unk[tex - R] >= 0) out[n++] = tex - R;
+      if (ty < R - 1 && unk[tex + R] >= 0) out[n++] = tex + R;
+      return n;
+    };
+
+    for (int tex = 0; tex < R * R; ++tex) {
+      const int j = unk[tex];
+      if (j < 0) continue;
+      const int x = tex % R, y = tex / R;
+      for (const Sub& s : subs) {
+        if (s.term != int(ti)) continue;
+        const double* cells = ws.cells.data() + s.cells;
+        // The cells having texel (x, y) as corner k (0: lower left, 1: lower
+        // right, 2: upper left, 3: upper right).
+        for (int k = 0; k < 4; ++k) {
+          const int cx = x - (k & 1), cy = y - (k >> 1);
+          if (cx < 0 || cy < 0 || cx > R - 2 || cy > R - 2) continue;
+          const int c = cy * R + cx;
+          const double* cs = cells + size_t(c) * kernels::kCellDoubles;
+          if (cs[0] == 0 && cs[5] == 0 && cs[10] == 0 && cs[15] == 0) continue;  // no sample in the cell
+          const int id[4] = {unk[c], unk[c + 1], unk[c + R], unk[c + R + 1]};  // increasing
+          for (int a = 0; a <= k; ++a) add(id[a], cs[4 * a + k]);  // Q(k, a), rows id[a] <= j
+          for (int ch = 0; ch < 3; ++ch) rhs(j, ch) += cs[16 + 4 * ch + k];
+          if (s.others.empty()) continue;
+          const int* start = ws.start.data() + s.start;
+          const size_t no = s.others.size(), sd = 3 + 2 * no;
+          const double* rec = ws.rec.data() + s.rec;
+          const int* rec_cell = ws.rec_cell.data() + s.rec_cell;
+          for (size_t o = 0; o < no; ++o) {
+            const TermLayout& to = terms[subs[s.others[o]].term];
+            const int Ro = to.proj.res;
+            const int* unko = to.unk.data();
+            const bool same = &to == &t;  // rows above j possible
+            for (int e = start[c]; e < start[c + 1]; ++e) {
+              const double* rd = rec + size_t(e) * sd;
+              const double a = rd[1], b = rd[2];
+              const double wj = rd[0] * ((k & 1 ? a : 1 - a) * (k & 2 ? b : 1 - b));
+              const double a2 = rd[3 + 2 * o], b2 = rd[4 + 2 * o];
+              const int co = rec_cell[size_t(e) * no + o];
+              const int io[4] = {unko[co], unko[co + 1], unko[co + Ro], unko[co + Ro + 1]};
+              const double bo[4] = {(1 - a2) * (1 - b2), a2 * (1 - b2), (1 - a2) * b2, a2 * b2};
+              for (int q = 0; q < 4; ++q)
+                if (!same || io[q] <= j) add(io[q], wj * bo[q]);
+            }
+          }
+        }
+      }
+      // mu L^T L: row j of L (deg j at j, -1 at its neighbours) and the rows of
+      // its neighbours n (deg n at n, -1 at n's neighbours, j among them).
+      int nj[4];
+      const int degj = nbrs(tex, nj);
+      if (degj > 0) {
+        add(j, mu * degj * degj);
+        for (int a = 0; a < degj; ++a) {
+          if (unk[nj[a]] < j) add(unk[nj[a]], -mu * degj);
+          int nn[4];
+          const int degn = nbrs(nj[a], nn);
+          if (unk[nj[a]] < j) add(unk[nj[a]], -mu * degn);
+          for (int b = 0; b < degn; ++b)
+            if (unk[nn[b]] <= j) add(unk[nn[b]], mu);
+        }
+      }
+      // The prior's rows through j, and j's level.
+      if (has_rows)
+        for (int at = ws.prior_start[j]; at < ws.prior_start[j + 1]; ++at) {
+          const int ea = ws.prior_entry[at], pr = ws.prior_row[at];
+          const double va = prior.w[pr] * prior.val[ea];
+          for (int eb = prior.start[pr]; eb < prior.start[pr + 1]; ++eb)
+            if (prior.idx[eb] <= j) add(prior.idx[eb], va * prior.val[eb]);
+        }
+      if (has_levels && ws.level_of[j] >= 0) {
+        const Prior::Level& lv = prior.levels[ws.level_of[j]];
+        const size_t a = static_cast<size_t>(std::lower_bound(lv.idx.begin(), lv.idx.end(), j) - lv.idx.begin());
+        for (size_t b = 0; b <= a; ++b) add(lv.idx[b], (a == b ? lv.w[a] : 0.0) - lv.w[a] * lv.w[b] / lv.sum);
+      }
+      // Read the column back in row order; the diagonal, always stored, comes last.
+      bits[j >> 6] |= uint64_t(1) << (j & 63);
+      for (int wd = 0; wd <= (j >> 6); ++wd) {
+        uint64_t m = bits[wd];
+        if (!m) continue;
+        bits[wd] = 0;
+        while (m) {
+          const int row = wd * 64 + __builtin_ctzll(m);
+          m &= m - 1;
+          A.i.push_back(row);
+          A.x.push_back(acc[row]);
+          acc[row] = 0.0;
+        }
+      }
+      A.p[j + 1] = static_cast<int>(A.i.size());
+    }
+  }
+  // The prior's right-hand side (as add_prior_dense).
+  for (size_t pr = 0; pr < prior.rows(); ++pr)
+    for (int a = prior.start[pr]; a < prior.start[pr + 1]; ++a)
+      for (int c = 0; c < 3; ++c) rhs(prior.idx[a], c) += prior.w[pr] * prior.val[a] * prior.target[pr][c];
+}
+
 #ifdef BF_FACTOR_CHOLMOD
 // CHOLMOD's supernodal factorization opens OpenMP parallel regions (Debian's
 // build asks for 4 threads in its larger supernodes). The fits already run one
@@ -747,6 +1011,86 @@ void cholmod_serial_openmp() {
   using Setter = void (*)(int);
   static const Setter set = reinterpret_cast<Setter>(dlsym(RTLD_DEFAULT, "omp_set_max_active_levels"));
   if (set) set(0);
+}
+
+// One CHOLMOD workspace per thread, with the sparse path's settings: AMD as
+// the only ordering (CHOLMOD's default also tries METIS on larger matrices:
+// AMD gives less fill here and costs less, docs/speed.md), a weighted
+// postorder, the supernodal LL^T kept as it is, no messages on stdout
+// (failures are thrown). Only workspace lives here: every fit orders, analyses
+// and factors its own matrix.
+struct CholmodCommon {
+  cholmod_common c;
+  CholmodCommon() {
+    cholmod_start(&c);
+    c.nmethods = 1;
+    c.method[0].ordering = CHOLMOD_AMD;
+    c.postorder = 1;
+    c.supernodal = CHOLMOD_SUPERNODAL;
+    c.final_asis = 1;
+    c.print = 0;
+  }
+  ~CholmodCommon() { cholmod_finish(&c); }
+  CholmodCommon(const CholmodCommon&) = delete;
+  CholmodCommon& operator=(const CholmodCommon&) = delete;
+};
+
+// Solves A Y = rhs (A: M x M, its upper triangle in A's compressed columns)
+// with CHOLMOD's supernodal Cholesky, called directly on views of A's arrays
+// and of rhs (no copies; upper storage is the form cholmod_factorize permutes
+// in one transpose). Throws std::runtime_error if CHOLMOD fails or A is not
+// positive definite.
+void cholmod_solve_upper(const Csc& A, int M, const Eigen::MatrixXd& rhs, Eigen::MatrixXd& Y) {
+  cholmod_serial_openmp();
+  thread_local CholmodCommon common;
+  cholmod_common& cc = common.c;
+  cholmod_sparse As{};
+  As.nrow = As.ncol = static_cast<size_t>(M);
+  As.nzmax = A.x.size();
+  As.p = const_cast<int*>(A.p.data());
+  As.i = const_cast<int*>(A.i.data());
+  As.x = const_cast<double*>(A.x.data());
+  As.stype = 1;  // upper triangle
+  As.itype = CHOLMOD_INT;
+  As.xtype = CHOLMOD_REAL;
+  As.dtype = CHOLMOD_DOUBLE;
+  As.sorted = 1;
+  As.packed = 1;
+  const auto failed = [&cc, M]() {
+    return std::runtime_error("fit: CHOLMOD failed with status " + std::to_string(cc.status) + " (" +
+                              std::to_string(M) + " unknowns)");
+  };
+  cholmod_factor* L = cholmod_analyze(&As, &cc);
+  if (!L || cc.status < 0) {
+    if (L) cholmod_free_factor(&L, &cc);
+    throw failed();
+  }
+  cholmod_factorize(&As, L, &cc);
+  if (cc.status < 0) {
+    cholmod_free_factor(&L, &cc);
+    throw failed();
+  }
+  if (L->minor < L->n) {
+    cholmod_free_factor(&L, &cc);
+    throw std::runtime_error("fit: the normal matrix is not positive definite (" + std::to_string(M) +
+                             " unknowns)");
+  }
+  cholmod_dense B{};
+  B.nrow = static_cast<size_t>(M);
+  B.ncol = static_cast<size_t>(rhs.cols());
+  B.nzmax = B.nrow * B.ncol;
+  B.d = B.nrow;
+  B.x = const_cast<double*>(rhs.data());
+  B.xtype = CHOLMOD_REAL;
+  B.dtype = CHOLMOD_DOUBLE;
+  cholmod_dense* X = cholmod_solve(CHOLMOD_A, L, &B, &cc);
+  cholmod_free_factor(&L, &cc);
+  if (!X || cc.status < 0) {
+    if (X) cholmod_free_dense(&X, &cc);
+    throw failed();
+  }
+  Y = Eigen::Map<const Eigen::MatrixXd>(static_cast<const double*>(X->x), M, rhs.cols());
+  cholmod_free_dense(&X, &cc);
 }
 #endif
 
@@ -875,12 +1219,11 @@ JointSolution solve_joint(const FitData& d, const std::array<std::vector<double>
   }
 
   if (solver == FitOptions::Solver::Sparse) {
-    using SpMat = SparseUpper;
-    SpMat A;
+    Csc& A = csc_workspace().A;
     Eigen::MatrixXd rhs;
-    assemble_sparse(d, r, terms, lookups, mu, prior, M, A, rhs);
-    // Each column's diagonal entry is its last (assemble_sparse).
-    const auto diag = [&A](int i) -> double& { return A.valuePtr()[A.outerIndexPtr()[i + 1] - 1]; };
+    assemble_sparse_csc(d, r, terms, lookups, mu, prior, M, A, rhs);
+    // Each column's diagonal entry is its last (assemble_sparse_csc).
+    const auto diag = [&A](int i) -> double& { return A.x[A.p[i + 1] - 1]; };
     double mean_diag = 0;
     for (int i = 0; i < M; ++i) mean_diag += diag(i);
     mean_diag /= std::max(M, 1);
@@ -892,27 +1235,17 @@ JointSolution solve_joint(const FitData& d, const std::array<std::vector<double>
     for (int i = 0; i < M; ++i) diag(i) += reg_diag;
 #ifdef BF_FACTOR_CHOLMOD
     // SuiteSparse's supernodal Cholesky (dense BLAS blocks on the supernodes),
-    // with AMD as the only ordering (CHOLMOD's default also tries METIS on
-    // larger matrices: AMD gives less fill here and costs less, docs/speed.md)
-    // and CHOLMOD's OpenMP regions serial (see cholmod_serial_openmp).
-    cholmod_serial_openmp();
-    Eigen::CholmodSupernodalLLT<SpMat, Eigen::Upper> llt;
-    cholmod_common& cc = llt.cholmod();
-    cc.nmethods = 1;
-    cc.method[0].ordering = CHOLMOD_AMD;
-    cc.postorder = 1;
-    cc.print = 0;  // no CHOLMOD messages on stdout: failures are thrown below
-    llt.compute(A);
-    if (cc.status < 0)
-      throw std::runtime_error("fit: CHOLMOD failed with status " + std::to_string(cc.status) + " (" +
-                               std::to_string(M) + " unknowns)");
+    // AMD ordering, CHOLMOD's OpenMP regions serial (cholmod_solve_upper).
+    cholmod_solve_upper(A, M, rhs, Y);
 #else
-    Eigen::SimplicialLLT<SpMat, Eigen::Upper, Eigen::AMDOrdering<int>> llt(A);
-#endif
+    const Eigen::Map<const SparseUpper> Am(M, M, static_cast<int>(A.x.size()), A.p.data(), A.i.data(),
+                                           A.x.data());
+    Eigen::SimplicialLLT<SparseUpper, Eigen::Upper, Eigen::AMDOrdering<int>> llt(Am);
     if (llt.info() != Eigen::Success)
       throw std::runtime_error("fit: the normal matrix is not positive definite (" +
                                std::to_string(M) + " unknowns)");
     Y = llt.solve(rhs);
+#endif
     if (!exact_error) {
       // As the dense path: at the solution A y = rhs, so the data residual is
       // sum w r^2 - y.rhs - (regularization quadratic form at y); the gauge
@@ -1092,6 +1425,43 @@ std::vector<TermSpec> mccool_terms(int res) {
   TermSpec p{projection_first_pair(Parameterization::WiWo, res), true, std::nullopt};
   TermSpec q{projection_first_pair(Parameterization::HalfDiff, res), false, std::nullopt};
   return {p, q};
+}
+
+SparseNormal sparse_normal_equations(const FitData& d, const std::vector<TermSpec>& joint, const FitOptions& opt,
+                                     bool reference) {
+  opt.validate();
+  if (joint.empty()) throw std::invalid_argument("fit: no terms to solve");
+  std::vector<TermLayout> terms;
+  std::vector<std::array<Lookups, 2>> own(joint.size());
+  std::vector<const std::array<Lookups, 2>*> lookups;
+  int M = 0;
+  for (size_t i = 0; i < joint.size(); ++i) {
+    add_layout(d, joint[i], M, terms, own[i]);
+    lookups.push_back(&own[i]);
+  }
+  const std::array<std::vector<double>, 3> no_fixed{std::vector<double>(d.size(), 0.0),
+                                                    std::vector<double>(d.size(), 0.0),
+                                                    std::vector<double>(d.size(), 0.0)};
+  const Prior prior = extrapolation_prior(d, no_fixed, terms, lookups, M, opt);
+  const double mu = opt.smoothing * d.W / std::max(M, 1);
+  const std::array<const double*, 3> r = {d.g[0].data(), d.g[1].data(), d.g[2].data()};
+  SparseNormal out;
+  out.M = M;
+  if (reference) {
+    SparseUpper A;
+    assemble_sparse(d, r, terms, lookups, mu, prior, M, A, out.rhs);
+    A.makeCompressed();
+    out.p.assign(A.outerIndexPtr(), A.outerIndexPtr() + M + 1);
+    out.i.assign(A.innerIndexPtr(), A.innerIndexPtr() + A.nonZeros());
+    out.x.assign(A.valuePtr(), A.valuePtr() + A.nonZeros());
+  } else {
+    Csc A;
+    assemble_sparse_csc(d, r, terms, lookups, mu, prior, M, A, out.rhs);
+    out.p = std::move(A.p);
+    out.i = std::move(A.i);
+    out.x = std::move(A.x);
+  }
+  return out;
 }
 
 Eigen::MatrixXd joint_normal_matrix(const FitData& d, const std::vector<TermSpec>& joint, const FitOptions& opt,

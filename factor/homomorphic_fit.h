@@ -179,6 +179,22 @@ std::shared_ptr<HomomorphicFactorization> fit_homomorphic(
 Eigen::MatrixXd joint_normal_matrix(const FitData& d, const std::vector<TermSpec>& joint, const FitOptions& opt,
                                     size_t max_unknowns, size_t* unknowns = nullptr);
 
+// The sparse path's normal equations for `joint` alone (no fixed terms, the
+// targets d.g), before its gauge and ridge: A's upper triangle in compressed
+// columns (p: M + 1 column starts, i: rows, x: values; rows sorted, every
+// diagonal entry stored, hence last in its column) and rhs (M x 3), in
+// solve_joint's unknown layout. `reference`: the triplet assembly (Eigen's
+// setFromTriplets) the column-by-column assembly replaced, the simple path
+// tests compare it with. Throws std::invalid_argument as solve_joint does.
+struct SparseNormal {
+  int M = 0;
+  std::vector<int> p, i;
+  std::vector<double> x;
+  Eigen::MatrixXd rhs;
+};
+SparseNormal sparse_normal_equations(const FitData& d, const std::vector<TermSpec>& joint, const FitOptions& opt,
+                                     bool reference);
+
 // McCool's fixed projections (thesis 2.1.1): p(wi) and p(wo) share one texture
 // (a reciprocal wiwo term), q(h) has its own (halfdiff, first pair; h through
 // the parabolic map). Two textures of size res.
