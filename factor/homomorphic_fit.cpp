@@ -760,6 +760,7 @@ struct CscWorkspace {
   std::vector<int> prior_row;    // ... and their rows
   std::vector<int> level_of;     // per unknown: its Prior::levels index, or -1
   Csc A;
+  std::vector<int> group, perm;  // the ordering's groups (texel_pairs) and the ordering
 };
 
 CscWorkspace& csc_workspace() {
@@ -1038,9 +1039,89 @@ struct CholmodCommon {
 // Solves A Y = rhs (A: M x M, its upper triangle in A's compressed columns)
 // with CHOLMOD's supernodal Cholesky, called directly on views of A's arrays
 // and of rhs (no copies; upper storage is the form cholmod_factorize permutes
-// in one transpose). Throws std::runtime_error if CHOLMOD fails or A is not
-// positive definite.
-void cholmod_solve_upper(const Csc& A, int M, const Eigen::MatrixXd& rhs, Eigen::MatrixXd& Y) {
+// in one transpose), ordered by grouped_amd on `group` (texel_pairs). Throws
+// std::runtime_error if CHOLMOD fails or A is not positive definite.
+// The ordering's groups (grouped_amd): each term's texels in pairs of
+// horizontal neighbours, (2 i, j) and (2 i + 1, j), the pairs of the terms one
+// after another. Coupled through the Laplacian and every cell they share, the
+// two texels of a pair have nearly the same neighbours, and AMD on the pairs'
+// graph costs a fraction of AMD on the texels' (measured, docs/speed.md,
+// "Texture 32: the sparse path, round 3": at texture 32, 1 ms instead of
+// 3.2 ms, for 11% more flops in the factorization; 2 x 2 and 1 x 2 groups
+// cost more flops than they save). group receives each unknown's group;
+// returns the number of groups.
+int texel_pairs(const std::vector<TermLayout>& terms, int M, std::vector<int>& group) {
+  group.assign(M, -1);
+  int ngroups = 0;
+  for (const TermLayout& t : terms) {
+    const int R = t.proj.res, G = (R + 1) / 2;
+    for (int tex = 0; tex < R * R; ++tex)
+      if (t.unk[tex] >= 0) group[t.unk[tex]] = ngroups + (tex / R) * G + (tex % R) / 2;
+    ngroups += G * R;
+  }
+  return ngroups;
+}
+
+// AMD on the quotient graph of `group` (per unknown: its group, 0 .. ngroups - 1):
+// the groups ordered by AMD on the graph where two groups are adjacent if A
+// couples any of their unknowns, each group's unknowns then in index order.
+// perm receives the fill-reducing order of the M unknowns.
+bool grouped_amd(const Csc& A, int M, const std::vector<int>& group, int ngroups, std::vector<int>& perm,
+                 cholmod_common& cc) {
+  // The quotient graph's upper triangle, one column per group: duplicates
+  // dropped with a marker, rows unsorted.
+  std::vector<int> count(size_t(ngroups) + 1, 0);
+  for (int j = 0; j < M; ++j)
+    for (int e = A.p[j]; e < A.p[j + 1]; ++e) {
+      const int gi = group[A.i[e]], gj = group[j];
+      if (gi != gj) ++count[std::max(gi, gj) + 1];
+    }
+  for (int g = 0; g < ngroups; ++g) count[g + 1] += count[g];
+  std::vector<int> rows(size_t(count[ngroups]));
+  std::vector<int> next(count.begin(), count.end() - 1);
+  for (int j = 0; j < M; ++j)
+    for (int e = A.p[j]; e < A.p[j + 1]; ++e) {
+      const int gi = group[A.i[e]], gj = group[j];
+      if (gi != gj) rows[next[std::max(gi, gj)]++] = std::min(gi, gj);
+    }
+  std::vector<int> cp(size_t(ngroups) + 1, 0), mark(ngroups, -1);
+  int nz = 0;
+  for (int g = 0; g < ngroups; ++g) {
+    for (int e = count[g]; e < count[g + 1]; ++e)
+      if (mark[rows[e]] != g) {
+        mark[rows[e]] = g;
+        rows[nz++] = rows[e];
+      }
+    cp[g + 1] = nz;
+  }
+  cholmod_sparse Q{};
+  Q.nrow = Q.ncol = static_cast<size_t>(ngroups);
+  Q.nzmax = static_cast<size_t>(std::max(nz, 1));
+  Q.p = cp.data();
+  Q.i = rows.data();
+  Q.stype = 1;
+  Q.itype = CHOLMOD_INT;
+  Q.xtype = CHOLMOD_PATTERN;
+  Q.dtype = CHOLMOD_DOUBLE;
+  Q.sorted = 0;
+  Q.packed = 1;
+  std::vector<int> gperm(ngroups);
+  if (!cholmod_amd(&Q, nullptr, 0, gperm.data(), &cc)) return false;
+  // Each group's unknowns in index order, the groups in AMD's order.
+  std::vector<int> gstart(size_t(ngroups) + 1, 0);
+  for (int j = 0; j < M; ++j) ++gstart[group[j] + 1];
+  for (int g = 0; g < ngroups; ++g) gstart[g + 1] += gstart[g];
+  std::vector<int> members(M);
+  next.assign(gstart.begin(), gstart.end() - 1);
+  for (int j = 0; j < M; ++j) members[next[group[j]]++] = j;
+  perm.clear();
+  for (const int g : gperm)
+    for (int e = gstart[g]; e < gstart[g + 1]; ++e) perm.push_back(members[e]);
+  return true;
+}
+
+void cholmod_solve_upper(const Csc& A, int M, const Eigen::MatrixXd& rhs, Eigen::MatrixXd& Y,
+                         const std::vector<int>& group, int ngroups) {
   cholmod_serial_openmp();
   thread_local CholmodCommon common;
   cholmod_common& cc = common.c;
@@ -1060,7 +1141,19 @@ void cholmod_solve_upper(const Csc& A, int M, const Eigen::MatrixXd& rhs, Eigen:
     return std::runtime_error("fit: CHOLMOD failed with status " + std::to_string(cc.status) + " (" +
                               std::to_string(M) + " unknowns)");
   };
-  cholmod_factor* L = cholmod_analyze(&As, &cc);
+  // The ordering: AMD on the quotient graph of `group` (grouped_amd), given to
+  // CHOLMOD, which follows it with its weighted postorder; AMD on A itself if
+  // that fails.
+  std::vector<int>& perm = csc_workspace().perm;
+  cholmod_factor* L = nullptr;
+  if (grouped_amd(A, M, group, ngroups, perm, cc)) {
+    cc.method[0].ordering = CHOLMOD_GIVEN;
+    L = cholmod_analyze_p(&As, perm.data(), nullptr, 0, &cc);
+    cc.method[0].ordering = CHOLMOD_AMD;
+  } else {
+    cc.status = CHOLMOD_OK;
+    L = cholmod_analyze(&As, &cc);
+  }
   if (!L || cc.status < 0) {
     if (L) cholmod_free_factor(&L, &cc);
     throw failed();
@@ -1236,7 +1329,9 @@ JointSolution solve_joint(const FitData& d, const std::array<std::vector<double>
 #ifdef BF_FACTOR_CHOLMOD
     // SuiteSparse's supernodal Cholesky (dense BLAS blocks on the supernodes),
     // AMD ordering, CHOLMOD's OpenMP regions serial (cholmod_solve_upper).
-    cholmod_solve_upper(A, M, rhs, Y);
+    std::vector<int>& group = csc_workspace().group;
+    const int ngroups = texel_pairs(terms, M, group);
+    cholmod_solve_upper(A, M, rhs, Y, group, ngroups);
 #else
     const Eigen::Map<const SparseUpper> Am(M, M, static_cast<int>(A.x.size()), A.p.data(), A.i.data(),
                                            A.x.data());
