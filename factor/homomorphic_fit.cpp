@@ -753,6 +753,10 @@ struct CscWorkspace {
   std::vector<double> rec;       // the current term's lookups' samples, bucketed by the lookup's
                                  // cell: w, fa, fb, then (fa, fb) of each other lookup
   std::vector<int> rec_cell;     // the same samples: the other lookups' cells
+  std::vector<int> slot;         // per cell of the other lookup: its block in the current cell, or -1
+  std::vector<int> pair_start;   // per (lookup, other lookup): per cell, the start of its blocks
+  std::vector<int> pair_cell;    // per block: the other lookup's cell
+  std::vector<double> pair_blk;  // per block: 16 sums w b_a b'_c (a: the lookup's corner, c: the other's)
   std::vector<double> acc;       // the column being assembled, by row (M)
   std::vector<uint64_t> bits;    // its rows that received a value
   std::vector<int> prior_start;  // per unknown (M + 1): its entries in the prior's rows ...
@@ -799,12 +803,13 @@ void assemble_sparse_csc(const FitData& d, const std::array<const double*, 3>& r
     size_t cells;             // offset into ws.cells
     std::vector<int> others;  // lookups of earlier terms and this term's other lookup
     size_t start = 0, rec = 0, rec_cell = 0;  // offsets, while its term is assembled
+    std::vector<size_t> pairs;                // per other lookup: offset into ws.pair_start
   };
   std::vector<Sub> subs;
   size_t ncells = 0;
   for (size_t ti = 0; ti < terms.size(); ++ti)
     for (int h = 0; h < (terms[ti].reciprocal ? 2 : 1); ++h) {
-      subs.push_back({int(ti), &(*lookups[ti])[h], ncells, {}});
+      subs.push_back({int(ti), &(*lookups[ti])[h], ncells, {}, 0, 0, 0, {}});
       ncells += size_t(terms[ti].proj.res) * terms[ti].proj.res * kernels::kCellDoubles;
     }
   for (size_t s = 0; s < subs.size(); ++s)
@@ -895,6 +900,48 @@ void assemble_sparse_csc(const FitData& d, const std::array<const double*, 3>& r
         }
       }
     }
+    // Per cell of each lookup and per other lookup, the samples' cross
+    // products summed per cell of the other lookup (a slot table over its
+    // cells): one 4 x 4 block per (cell, other cell) pair, in sample order.
+    ws.pair_start.clear();
+    ws.pair_cell.clear();
+    ws.pair_blk.clear();
+    for (Sub& s : subs) {
+      if (s.term != int(ti) || s.others.empty()) continue;
+      const int* start = ws.start.data() + s.start;
+      const size_t no = s.others.size(), sd = 3 + 2 * no;
+      const double* rec = ws.rec.data() + s.rec;
+      const int* rec_cell = ws.rec_cell.data() + s.rec_cell;
+      s.pairs.assign(no, 0);
+      for (size_t o = 0; o < no; ++o) {
+        const int Ro = terms[subs[s.others[o]].term].proj.res;
+        s.pairs[o] = ws.pair_start.size();
+        ws.slot.assign(size_t(Ro) * Ro, -1);
+        ws.pair_start.push_back(static_cast<int>(ws.pair_cell.size()));
+        for (int c = 0; c < R * R; ++c) {
+          const size_t first = ws.pair_cell.size();
+          for (int e = start[c]; e < start[c + 1]; ++e) {
+            const double* rd = rec + size_t(e) * sd;
+            const int co = rec_cell[size_t(e) * no + o];
+            int sl = ws.slot[co];
+            if (sl < 0) {
+              sl = ws.slot[co] = static_cast<int>(ws.pair_cell.size() - first);
+              ws.pair_cell.push_back(co);
+              ws.pair_blk.resize(ws.pair_blk.size() + 16, 0.0);
+            }
+            const double a = rd[1], b = rd[2], wk = rd[0];
+            const double sp[4] = {wk * ((1 - a) * (1 - b)), wk * (a * (1 - b)), wk * ((1 - a) * b), wk * (a * b)};
+            const double a2 = rd[3 + 2 * o], b2 = rd[4 + 2 * o];
+            const double sq[4] = {(1 - a2) * (1 - b2), a2 * (1 - b2), (1 - a2) * b2, a2 * b2};
+            double* bk = ws.pair_blk.data() + 16 * (first + size_t(sl));
+            for (int p2 = 0; p2 < 4; ++p2)
+              for (int q2 = 0; q2 < 4; ++q2) bk[4 * p2 + q2] += sp[p2] * sq[q2];
+          }
+          for (size_t pb = first; pb < ws.pair_cell.size(); ++pb) ws.slot[ws.pair_cell[pb]] = -1;
+          ws.pair_start.push_back(static_cast<int>(ws.pair_cell.size()));
+        }
+      }
+    }
 
     // The Laplacian's neighbours of a texel: texels of the mask, left, right, below, above.
     const auto nbrs = [&](int tex, int* out) {
@@ -926,25 +973,18 @@ void assemble_sparse_csc(const FitData& d, const std::array<const double*, 3>& r
           for (int a = 0; a <= k; ++a) add(id[a], cs[4 * a + k]);  // Q(k, a), rows id[a] <= j
           for (int ch = 0; ch < 3; ++ch) rhs(j, ch) += cs[16 + 4 * ch + k];
           if (s.others.empty()) continue;
-          const int* start = ws.start.data() + s.start;
-          const size_t no = s.others.size(), sd = 3 + 2 * no;
-          const double* rec = ws.rec.data() + s.rec;
-          const int* rec_cell = ws.rec_cell.data() + s.rec_cell;
-          for (size_t o = 0; o < no; ++o) {
+          for (size_t o = 0; o < s.others.size(); ++o) {
             const TermLayout& to = terms[subs[s.others[o]].term];
             const int Ro = to.proj.res;
             const int* unko = to.unk.data();
             const bool same = &to == &t;  // rows above j possible
-            for (int e = start[c]; e < start[c + 1]; ++e) {
-              const double* rd = rec + size_t(e) * sd;
-              const double a = rd[1], b = rd[2];
-              const double wj = rd[0] * ((k & 1 ? a : 1 - a) * (k & 2 ? b : 1 - b));
-              const double a2 = rd[3 + 2 * o], b2 = rd[4 + 2 * o];
-              const int co = rec_cell[size_t(e) * no + o];
+            const int* ps = ws.pair_start.data() + s.pairs[o];
+            for (int pb = ps[c]; pb < ps[c + 1]; ++pb) {
+              const int co = ws.pair_cell[pb];
               const int io[4] = {unko[co], unko[co + 1], unko[co + Ro], unko[co + Ro + 1]};
-              const double bo[4] = {(1 - a2) * (1 - b2), a2 * (1 - b2), (1 - a2) * b2, a2 * b2};
+              const double* bk = ws.pair_blk.data() + 16 * size_t(pb) + 4 * k;
               for (int q = 0; q < 4; ++q)
-                if (!same || io[q] <= j) add(io[q], wj * bo[q]);
+                if (!same || io[q] <= j) add(io[q], bk[q]);
             }
           }
         }
