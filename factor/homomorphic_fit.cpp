@@ -1328,13 +1328,13 @@ JointSolution solve_joint(const FitData& d, const std::array<std::vector<double>
   std::vector<double> val(maxL);
 
   FitOptions::Solver solver = opt.solver;
-  // Auto: dense up to 1,300 unknowns, or up to 1,800 with 500,000 samples or
+  // Auto: dense up to 1,060 unknowns, or up to 1,800 with 500,000 samples or
   // more (the sparse assembly costs more per sample); measured crossovers with
-  // the banded-head dense Cholesky (docs/speed.md, "Dense against sparse"):
-  // 43,264 samples at about 1,270 unknowns (equal at 1,268), 1M samples
-  // between 1,640 and 2,046.
+  // the banded-head dense Cholesky (docs/speed.md, "Texture 32: the sparse
+  // path, round 3"): 43,264 samples between 1,022 and 1,098 unknowns (about
+  // 1,060 interpolated), 1M samples between 1,640 and 2,046.
   if (solver == FitOptions::Solver::Auto)
-    solver = M <= (N >= 500000 ? 1800 : 1300) ? FitOptions::Solver::Dense : FitOptions::Solver::Sparse;
+    solver = M <= (N >= 500000 ? 1800 : 1060) ? FitOptions::Solver::Dense : FitOptions::Solver::Sparse;
 
   // Residual targets g - fixed (a prefix holds them) and, for the objective
   // read off the normal equations, sum w r^2 per channel: both assembled paths.
