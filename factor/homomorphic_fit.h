@@ -65,9 +65,10 @@ struct FitOptions {
   // f <= A exp(max g) ~ the largest training value everywhere. Default on.
   bool clamp_log_range = true;
   // Dense: normal matrix assembled densely, LLT. Sparse: normal matrix assembled
-  // directly in compressed columns, CHOLMOD supernodal LLT with AMD (SimplicialLLT without CHOLMOD).
-  // Auto: dense up to 1,300 unknowns (1,800 with 500,000 samples or more), sparse above (measured
-  // crossovers, docs/speed.md "Sparse path"). ReferenceQR: the
+  // column by column in compressed columns, CHOLMOD supernodal LLT ordered by AMD on
+  // pairs of texels (SimplicialLLT with AMD without CHOLMOD).
+  // Auto: dense up to 1,060 unknowns (1,800 with 500,000 samples or more), sparse above (measured
+  // crossovers, docs/speed.md "Texture 32: the sparse path, round 3"). ReferenceQR: the
   // simple path (dense B, Householder QR, no normal equations) for tests.
   enum class Solver { Auto, Dense, Sparse, ReferenceQR } solver = Solver::Auto;
   // Throws std::invalid_argument naming the field, its value and the rule.
