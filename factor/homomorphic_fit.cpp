@@ -569,8 +569,8 @@ struct SampleRec {
   int cq;
 };
 
-// Buffers of the sparse assembly, one set per thread, reused across fits (the
-// dense path has its own Workspace). Nothing is carried from one fit to the next.
+// Buffers of the triplet assembly (assemble_sparse, the tests' reference), one
+// set per thread, reused across fits. Nothing is carried from one fit to the next.
 struct SparseWorkspace {
   std::vector<Eigen::Triplet<double>> trip;  // (row <= col) contributions to A
   std::vector<double> cells;                 // per-cell self sums of one lookup (kernels::cell_sums)
@@ -588,7 +588,9 @@ SparseWorkspace& sparse_workspace() {
   return ws;
 }
 
-// The sparse path's normal equations A y = rhs without the gauge and ridge:
+// The triplet assembly the sparse path used before assemble_sparse_csc, kept
+// as the reference the tests compare it with (sparse_normal_equations):
+// the sparse path's normal equations A y = rhs without the gauge and ridge:
 // A (M x M, upper triangle only, compressed with sorted rows, every diagonal
 // entry stored, hence last in its column; with CHOLMOD about 4% faster than
 // the lower triangle at texture 32) =
@@ -782,8 +784,11 @@ CscWorkspace& csc_workspace() {
 //  - the cross products with the lookups of earlier terms and with t's other
 //    lookup (reciprocal): each of t's lookups has its samples bucketed by its
 //    cell (counting sort, sample order kept) together with the other lookups'
-//    cells and fractions; over the samples of j's cells, w b_j (the sample's
-//    weight at j) times the other lookup's 4 corner weights;
+//    cells and fractions, and per cell the 4 x 4 products w b b'^T summed per
+//    cell of the other lookup (a slot table), one block per (cell, other cell)
+//    pair, as assemble_sparse does; column j adds row k of the blocks of each
+//    cell it is corner k of (summing per sample instead, 4 visits of every
+//    sample, cost 20% more a fit at 1M samples);
 //  - mu L^T L (the Laplacian rows of j and of its neighbours), the prior's
 //    rows through j and j's prior level.
 // A column's rows are summed in a dense accumulator with a bitset of the rows
