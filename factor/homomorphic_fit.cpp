@@ -1092,9 +1092,10 @@ struct CholmodCommon {
 // two texels of a pair have nearly the same neighbours, and AMD on the pairs'
 // graph costs a fraction of AMD on the texels' (measured, docs/speed.md,
 // "Texture 32: the sparse path, round 3": at texture 32, 1 ms instead of
-// 3.2 ms, for 11% more flops in the factorization; 2 x 2 and 1 x 2 groups
-// cost more flops than they save). group receives each unknown's group;
-// returns the number of groups.
+// 3.2 ms, for 11% more flops in the factorization; 2 x 2 groups were as fast
+// with 20% more flops, 1 x 2 groups slower). group receives each unknown's
+// group (groups without unknowns stay isolated nodes); returns the number of
+// groups.
 int texel_pairs(const std::vector<TermLayout>& terms, int M, std::vector<int>& group) {
   group.assign(M, -1);
   int ngroups = 0;
