@@ -10,7 +10,7 @@
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
 #ifdef BF_FACTOR_CHOLMOD
-#include <Eigen/CholmodSupport>
+#include <cholmod.h>
 #include <dlfcn.h>
 #endif
 #include <algorithm>
@@ -607,8 +607,8 @@ struct SampleRec {
   int cq;
 };
 
-// Buffers of the sparse assembly, one set per thread, reused across fits (the
-// dense path has its own Workspace). Nothing is carried from one fit to the next.
+// Buffers of the triplet assembly (assemble_sparse, the tests' reference), one
+// set per thread, reused across fits. Nothing is carried from one fit to the next.
 struct SparseWorkspace {
   std::vector<Eigen::Triplet<double>> trip;  // (row <= col) contributions to A
   std::vector<double> cells;                 // per-cell self sums of one lookup (kernels::cell_sums)
@@ -626,7 +626,9 @@ SparseWorkspace& sparse_workspace() {
   return ws;
 }
 
-// The sparse path's normal equations A y = rhs without the gauge and ridge:
+// The triplet assembly the sparse path used before assemble_sparse_csc, kept
+// as the reference the tests compare it with (sparse_normal_equations):
+// the sparse path's normal equations A y = rhs without the gauge and ridge:
 // A (M x M, upper triangle only, compressed with sorted rows, every diagonal
 // entry stored, hence last in its column; with CHOLMOD about 4% faster than
 // the lower triangle at texture 32) =
@@ -773,6 +775,314 @@ void assemble_sparse(const FitData& d, const std::array<const double*, 3>& r,
   if (trip.capacity() > (size_t(4) << 20)) std::vector<Eigen::Triplet<double>>().swap(trip);
 }
 
+// The sparse normal matrix in compressed columns (upper triangle: column j
+// holds rows i <= j, sorted, its diagonal entry always stored, hence last).
+struct Csc {
+  std::vector<int> p;     // M + 1 column starts
+  std::vector<int> i;     // row of each entry
+  std::vector<double> x;  // value of each entry
+};
+
+// Buffers of the column-by-column assembly (assemble_sparse_csc), one set per
+// thread, reused across fits so that a search's fits do not allocate them
+// again; nothing is carried from one fit to the next.
+struct CscWorkspace {
+  std::vector<double> cells;     // every lookup's per-cell sums (kernels::cell_sums), one after another
+  std::vector<int> start;        // bucket starts (cells + 1) of the current term's lookups
+  std::vector<int> next;         // bucket fill positions
+  std::vector<double> rec;       // the current term's lookups' samples, bucketed by the lookup's
+                                 // cell: w, fa, fb, then (fa, fb) of each other lookup
+  std::vector<int> rec_cell;     // the same samples: the other lookups' cells
+  std::vector<int> slot;         // per cell of the other lookup: its block in the current cell, or -1
+  std::vector<int> pair_start;   // per (lookup, other lookup): per cell, the start of its blocks
+  std::vector<int> pair_cell;    // per block: the other lookup's cell
+  std::vector<double> pair_blk;  // per block: 16 sums w b_a b'_c (a: the lookup's corner, c: the other's)
+  std::vector<double> acc;       // the column being assembled, by row (M)
+  std::vector<uint64_t> bits;    // its rows that received a value
+  std::vector<int> prior_start;  // per unknown (M + 1): its entries in the prior's rows ...
+  std::vector<int> prior_entry;  // ... as indices into Prior::idx
+  std::vector<int> prior_row;    // ... and their rows
+  std::vector<int> level_of;     // per unknown: its Prior::levels index, or -1
+  Csc A;
+  std::vector<int> group, perm;  // the ordering's groups (texel_pairs) and the ordering
+};
+
+CscWorkspace& csc_workspace() {
+  thread_local CscWorkspace ws;
+  return ws;
+}
+
+// The sparse path's normal equations A y = rhs without the gauge and ridge:
+// the same as assemble_sparse up to summation order, assembled column by
+// column straight into compressed storage (no triplets, no sort). Column j, a
+// texel of term t, receives (rows <= j only):
+//  - the self products of each of t's lookups from the per-cell sums
+//    (kernels::cell_sums) of the up to 4 cells having j as a corner, and j's
+//    right-hand side from the same cells;
+//  - the cross products with the lookups of earlier terms and with t's other
+//    lookup (reciprocal): each of t's lookups has its samples bucketed by its
+//    cell (counting sort, sample order kept) together with the other lookups'
+//    cells and fractions, and per cell the 4 x 4 products w b b'^T summed per
+//    cell of the other lookup (a slot table), one block per (cell, other cell)
+//    pair, as assemble_sparse does; column j adds row k of the blocks of each
+//    cell it is corner k of (summing per sample instead, 4 visits of every
+//    sample, cost 20% more a fit at 1M samples);
+//  - mu L^T L (the Laplacian rows of j and of its neighbours), the prior's
+//    rows through j and j's prior level.
+// A column's rows are summed in a dense accumulator with a bitset of the rows
+// set, read back in row order.
+void assemble_sparse_csc(const FitData& d, const std::array<const double*, 3>& r,
+                         const std::vector<TermLayout>& terms,
+                         const std::vector<const std::array<Lookups, 2>*>& lookups, double mu,
+                         const Prior& prior, int M, Csc& A, Eigen::MatrixXd& rhs) {
+  const size_t N = d.size();
+  const double* w = d.w.data();
+  CscWorkspace& ws = csc_workspace();
+  rhs.setZero(M, 3);
+
+  struct Sub {
+    int term;
+    const Lookups* lk;
+    size_t cells;             // offset into ws.cells
+    std::vector<int> others;  // lookups of earlier terms and this term's other lookup
+    size_t start = 0, rec = 0, rec_cell = 0;  // offsets, while its term is assembled
+    std::vector<size_t> pairs;                // per other lookup: offset into ws.pair_start
+  };
+  std::vector<Sub> subs;
+  size_t ncells = 0;
+  for (size_t ti = 0; ti < terms.size(); ++ti)
+    for (int h = 0; h < (terms[ti].reciprocal ? 2 : 1); ++h) {
+      subs.push_back({int(ti), &(*lookups[ti])[h], ncells, {}, 0, 0, 0, {}});
+      ncells += size_t(terms[ti].proj.res) * terms[ti].proj.res * kernels::kCellDoubles;
+    }
+  for (size_t s = 0; s < subs.size(); ++s)
+    for (size_t o = 0; o < subs.size(); ++o)
+      if (o != s && subs[o].term <= subs[s].term) subs[s].others.push_back(int(o));
+  ws.cells.assign(ncells, 0.0);
+  for (const Sub& s : subs)
+    kernels::cell_sums(N, s.lk->cell.data(), s.lk->fa.data(), s.lk->fb.data(), w, r[0], r[1], r[2],
+                       ws.cells.data() + s.cells);
+
+  // The prior: per unknown, its entries in the prior's rows, and its level.
+  const bool has_rows = prior.rows() > 0;
+  if (has_rows) {
+    ws.prior_start.assign(size_t(M) + 1, 0);
+    for (const int u : prior.idx) ++ws.prior_start[u + 1];
+    for (int u = 0; u < M; ++u) ws.prior_start[u + 1] += ws.prior_start[u];
+    ws.prior_entry.resize(prior.idx.size());
+    ws.prior_row.resize(prior.idx.size());
+    ws.next.assign(ws.prior_start.begin(), ws.prior_start.end() - 1);
+    for (size_t pr = 0; pr < prior.rows(); ++pr)
+      for (int e = prior.start[pr]; e < prior.start[pr + 1]; ++e) {
+        const int at = ws.next[prior.idx[e]]++;
+        ws.prior_entry[at] = e;
+        ws.prior_row[at] = static_cast<int>(pr);
+      }
+  }
+  const bool has_levels = !prior.levels.empty();
+  if (has_levels) {
+    ws.level_of.assign(M, -1);
+    for (size_t l = 0; l < prior.levels.size(); ++l)
+      for (const int u : prior.levels[l].idx) ws.level_of[u] = static_cast<int>(l);
+  }
+
+  ws.acc.assign(M, 0.0);
+  ws.bits.assign((size_t(M) + 63) / 64, 0);
+  double* acc = ws.acc.data();
+  uint64_t* bits = ws.bits.data();
+  const auto add = [acc, bits](int row, double v) {
+    acc[row] += v;
+    bits[row >> 6] |= uint64_t(1) << (row & 63);
+  };
+  A.p.resize(size_t(M) + 1);
+  A.i.clear();
+  A.x.clear();
+  A.p[0] = 0;
+  for (size_t ti = 0; ti < terms.size(); ++ti) {
+    const TermLayout& t = terms[ti];
+    const int R = t.proj.res;
+    const int* unk = t.unk.data();
+
+    // Bucket the samples by the cell of each of this term's lookups that has others.
+    size_t nstart = 0, nrec = 0, nrec_cell = 0;
+    for (Sub& s : subs) {
+      if (s.term != int(ti) || s.others.empty()) continue;
+      s.start = nstart;
+      s.rec = nrec;
+      s.rec_cell = nrec_cell;
+      nstart += size_t(R) * R + 1;
+      nrec += N * (3 + 2 * s.others.size());
+      nrec_cell += N * s.others.size();
+    }
+    ws.start.assign(nstart, 0);
+    ws.rec.resize(nrec);
+    ws.rec_cell.resize(nrec_cell);
+    for (const Sub& s : subs) {
+      if (s.term != int(ti) || s.others.empty()) continue;
+      int* start = ws.start.data() + s.start;
+      const int* cell = s.lk->cell.data();
+      for (size_t k = 0; k < N; ++k) ++start[cell[k] + 1];
+      for (int c = 0; c < R * R; ++c) start[c + 1] += start[c];
+      ws.next.assign(start, start + size_t(R) * R);
+      const size_t no = s.others.size(), sd = 3 + 2 * no;
+      double* rec = ws.rec.data() + s.rec;
+      int* rec_cell = ws.rec_cell.data() + s.rec_cell;
+      const double* fa = s.lk->fa.data();
+      const double* fb = s.lk->fb.data();
+      for (size_t k = 0; k < N; ++k) {
+        const size_t e = static_cast<size_t>(ws.next[cell[k]]++);
+        double* rd = rec + e * sd;
+        rd[0] = w[k];
+        rd[1] = fa[k];
+        rd[2] = fb[k];
+        for (size_t o = 0; o < no; ++o) {
+          const Lookups& lo = *subs[s.others[o]].lk;
+          rd[3 + 2 * o] = lo.fa[k];
+          rd[4 + 2 * o] = lo.fb[k];
+          rec_cell[e * no + o] = lo.cell[k];
+        }
+      }
+    }
+    // Per cell of each lookup and per other lookup, the samples' cross
+    // products summed per cell of the other lookup (a slot table over its
+    // cells): one 4 x 4 block per (cell, other cell) pair, in sample order.
+    ws.pair_start.clear();
+    ws.pair_cell.clear();
+    ws.pair_blk.clear();
+    for (Sub& s : subs) {
+      if (s.term != int(ti) || s.others.empty()) continue;
+      const int* start = ws.start.data() + s.start;
+      const size_t no = s.others.size(), sd = 3 + 2 * no;
+      const double* rec = ws.rec.data() + s.rec;
+      const int* rec_cell = ws.rec_cell.data() + s.rec_cell;
+      s.pairs.assign(no, 0);
+      for (size_t o = 0; o < no; ++o) {
+        const int Ro = terms[subs[s.others[o]].term].proj.res;
+        s.pairs[o] = ws.pair_start.size();
+        ws.slot.assign(size_t(Ro) * Ro, -1);
+        ws.pair_start.push_back(static_cast<int>(ws.pair_cell.size()));
+        for (int c = 0; c < R * R; ++c) {
+          const size_t first = ws.pair_cell.size();
+          for (int e = start[c]; e < start[c + 1]; ++e) {
+            const double* rd = rec + size_t(e) * sd;
+            const int co = rec_cell[size_t(e) * no + o];
+            int sl = ws.slot[co];
+            if (sl < 0) {
+              sl = ws.slot[co] = static_cast<int>(ws.pair_cell.size() - first);
+              ws.pair_cell.push_back(co);
+              ws.pair_blk.resize(ws.pair_blk.size() + 16, 0.0);
+            }
+            const double a = rd[1], b = rd[2], wk = rd[0];
+            const double sp[4] = {wk * ((1 - a) * (1 - b)), wk * (a * (1 - b)), wk * ((1 - a) * b), wk * (a * b)};
+            const double a2 = rd[3 + 2 * o], b2 = rd[4 + 2 * o];
+            const double sq[4] = {(1 - a2) * (1 - b2), a2 * (1 - b2), (1 - a2) * b2, a2 * b2};
+            double* bk = ws.pair_blk.data() + 16 * (first + size_t(sl));
+            for (int p2 = 0; p2 < 4; ++p2)
+              for (int q2 = 0; q2 < 4; ++q2) bk[4 * p2 + q2] += sp[p2] * sq[q2];
+          }
+          for (size_t pb = first; pb < ws.pair_cell.size(); ++pb) ws.slot[ws.pair_cell[pb]] = -1;
+          ws.pair_start.push_back(static_cast<int>(ws.pair_cell.size()));
+        }
+      }
+    }
+
+    // The Laplacian's neighbours of a texel: texels of the mask, left, right, below, above.
+    const auto nbrs = [&](int tex, int* out) {
+      const int tx = tex % R, ty = tex / R;
+      int n = 0;
+      if (tx > 0 && unk[tex - 1] >= 0) out[n++] = tex - 1;
+      if (tx < R - 1 && unk[tex + 1] >= 0) out[n++] = tex + 1;
+      if (ty > 0 && unk[tex - R] >= 0) out[n++] = tex - R;
+      if (ty < R - 1 && unk[tex + R] >= 0) out[n++] = tex + R;
+      return n;
+    };
+
+    for (int tex = 0; tex < R * R; ++tex) {
+      const int j = unk[tex];
+      if (j < 0) continue;
+      const int x = tex % R, y = tex / R;
+      for (const Sub& s : subs) {
+        if (s.term != int(ti)) continue;
+        const double* cells = ws.cells.data() + s.cells;
+        // The cells having texel (x, y) as corner k (0: lower left, 1: lower
+        // right, 2: upper left, 3: upper right).
+        for (int k = 0; k < 4; ++k) {
+          const int cx = x - (k & 1), cy = y - (k >> 1);
+          if (cx < 0 || cy < 0 || cx > R - 2 || cy > R - 2) continue;
+          const int c = cy * R + cx;
+          const double* cs = cells + size_t(c) * kernels::kCellDoubles;
+          if (cs[0] == 0 && cs[5] == 0 && cs[10] == 0 && cs[15] == 0) continue;  // no sample in the cell
+          const int id[4] = {unk[c], unk[c + 1], unk[c + R], unk[c + R + 1]};  // increasing
+          for (int a = 0; a <= k; ++a) add(id[a], cs[4 * a + k]);  // Q(k, a), rows id[a] <= j
+          for (int ch = 0; ch < 3; ++ch) rhs(j, ch) += cs[16 + 4 * ch + k];
+          if (s.others.empty()) continue;
+          for (size_t o = 0; o < s.others.size(); ++o) {
+            const TermLayout& to = terms[subs[s.others[o]].term];
+            const int Ro = to.proj.res;
+            const int* unko = to.unk.data();
+            const bool same = &to == &t;  // rows above j possible
+            const int* ps = ws.pair_start.data() + s.pairs[o];
+            for (int pb = ps[c]; pb < ps[c + 1]; ++pb) {
+              const int co = ws.pair_cell[pb];
+              const int io[4] = {unko[co], unko[co + 1], unko[co + Ro], unko[co + Ro + 1]};
+              const double* bk = ws.pair_blk.data() + 16 * size_t(pb) + 4 * k;
+              for (int q = 0; q < 4; ++q)
+                if (!same || io[q] <= j) add(io[q], bk[q]);
+            }
+          }
+        }
+      }
+      // mu L^T L: row j of L (deg j at j, -1 at its neighbours) and the rows of
+      // its neighbours n (deg n at n, -1 at n's neighbours, j among them).
+      int nj[4];
+      const int degj = nbrs(tex, nj);
+      if (degj > 0) {
+        add(j, mu * degj * degj);
+        for (int a = 0; a < degj; ++a) {
+          if (unk[nj[a]] < j) add(unk[nj[a]], -mu * degj);
+          int nn[4];
+          const int degn = nbrs(nj[a], nn);
+          if (unk[nj[a]] < j) add(unk[nj[a]], -mu * degn);
+          for (int b = 0; b < degn; ++b)
+            if (unk[nn[b]] <= j) add(unk[nn[b]], mu);
+        }
+      }
+      // The prior's rows through j, and j's level.
+      if (has_rows)
+        for (int at = ws.prior_start[j]; at < ws.prior_start[j + 1]; ++at) {
+          const int ea = ws.prior_entry[at], pr = ws.prior_row[at];
+          const double va = prior.w[pr] * prior.val[ea];
+          for (int eb = prior.start[pr]; eb < prior.start[pr + 1]; ++eb)
+            if (prior.idx[eb] <= j) add(prior.idx[eb], va * prior.val[eb]);
+        }
+      if (has_levels && ws.level_of[j] >= 0) {
+        const Prior::Level& lv = prior.levels[ws.level_of[j]];
+        const size_t a = static_cast<size_t>(std::lower_bound(lv.idx.begin(), lv.idx.end(), j) - lv.idx.begin());
+        for (size_t b = 0; b <= a; ++b) add(lv.idx[b], (a == b ? lv.w[a] : 0.0) - lv.w[a] * lv.w[b] / lv.sum);
+      }
+      // Read the column back in row order; the diagonal, always stored, comes last.
+      bits[j >> 6] |= uint64_t(1) << (j & 63);
+      for (int wd = 0; wd <= (j >> 6); ++wd) {
+        uint64_t m = bits[wd];
+        if (!m) continue;
+        bits[wd] = 0;
+        while (m) {
+          const int row = wd * 64 + __builtin_ctzll(m);
+          m &= m - 1;
+          A.i.push_back(row);
+          A.x.push_back(acc[row]);
+          acc[row] = 0.0;
+        }
+      }
+      A.p[j + 1] = static_cast<int>(A.i.size());
+    }
+  }
+  // The prior's right-hand side (as add_prior_dense).
+  for (size_t pr = 0; pr < prior.rows(); ++pr)
+    for (int a = prior.start[pr]; a < prior.start[pr + 1]; ++a)
+      for (int c = 0; c < 3; ++c) rhs(prior.idx[a], c) += prior.w[pr] * prior.val[a] * prior.target[pr][c];
+}
+
 #ifdef BF_FACTOR_CHOLMOD
 // CHOLMOD's supernodal factorization opens OpenMP parallel regions (Debian's
 // build asks for 4 threads in its larger supernodes). The fits already run one
@@ -785,6 +1095,179 @@ void cholmod_serial_openmp() {
   using Setter = void (*)(int);
   static const Setter set = reinterpret_cast<Setter>(dlsym(RTLD_DEFAULT, "omp_set_max_active_levels"));
   if (set) set(0);
+}
+
+// One CHOLMOD workspace per thread, with the sparse path's settings: AMD as
+// the only ordering (CHOLMOD's default also tries METIS on larger matrices:
+// AMD gives less fill here and costs less, docs/speed.md), a weighted
+// postorder, the supernodal LL^T kept as it is, no messages on stdout
+// (failures are thrown). Only workspace lives here: every fit orders, analyses
+// and factors its own matrix.
+struct CholmodCommon {
+  cholmod_common c;
+  CholmodCommon() {
+    cholmod_start(&c);
+    c.nmethods = 1;
+    c.method[0].ordering = CHOLMOD_AMD;
+    c.postorder = 1;
+    c.supernodal = CHOLMOD_SUPERNODAL;
+    c.final_asis = 1;
+    c.print = 0;
+  }
+  ~CholmodCommon() { cholmod_finish(&c); }
+  CholmodCommon(const CholmodCommon&) = delete;
+  CholmodCommon& operator=(const CholmodCommon&) = delete;
+};
+
+// Solves A Y = rhs (A: M x M, its upper triangle in A's compressed columns)
+// with CHOLMOD's supernodal Cholesky, called directly on views of A's arrays
+// and of rhs (no copies; upper storage is the form cholmod_factorize permutes
+// in one transpose), ordered by grouped_amd on `group` (texel_pairs). Throws
+// std::runtime_error if CHOLMOD fails or A is not positive definite.
+// The ordering's groups (grouped_amd): each term's texels in pairs of
+// horizontal neighbours, (2 i, j) and (2 i + 1, j), the pairs of the terms one
+// after another. Coupled through the Laplacian and every cell they share, the
+// two texels of a pair have nearly the same neighbours, and AMD on the pairs'
+// graph costs a fraction of AMD on the texels' (measured, docs/speed.md,
+// "Texture 32: the sparse path, round 3": at texture 32, 1 ms instead of
+// 3.2 ms, for 11% more flops in the factorization; 2 x 2 groups were as fast
+// with 20% more flops, 1 x 2 groups slower). group receives each unknown's
+// group (groups without unknowns stay isolated nodes); returns the number of
+// groups.
+int texel_pairs(const std::vector<TermLayout>& terms, int M, std::vector<int>& group) {
+  group.assign(M, -1);
+  int ngroups = 0;
+  for (const TermLayout& t : terms) {
+    const int R = t.proj.res, G = (R + 1) / 2;
+    for (int tex = 0; tex < R * R; ++tex)
+      if (t.unk[tex] >= 0) group[t.unk[tex]] = ngroups + (tex / R) * G + (tex % R) / 2;
+    ngroups += G * R;
+  }
+  return ngroups;
+}
+
+// AMD on the quotient graph of `group` (per unknown: its group, 0 .. ngroups - 1):
+// the groups ordered by AMD on the graph where two groups are adjacent if A
+// couples any of their unknowns, each group's unknowns then in index order.
+// perm receives the fill-reducing order of the M unknowns.
+bool grouped_amd(const Csc& A, int M, const std::vector<int>& group, int ngroups, std::vector<int>& perm,
+                 cholmod_common& cc) {
+  // The quotient graph's upper triangle, one column per group: duplicates
+  // dropped with a marker, rows unsorted.
+  std::vector<int> count(size_t(ngroups) + 1, 0);
+  for (int j = 0; j < M; ++j)
+    for (int e = A.p[j]; e < A.p[j + 1]; ++e) {
+      const int gi = group[A.i[e]], gj = group[j];
+      if (gi != gj) ++count[std::max(gi, gj) + 1];
+    }
+  for (int g = 0; g < ngroups; ++g) count[g + 1] += count[g];
+  std::vector<int> rows(size_t(count[ngroups]));
+  std::vector<int> next(count.begin(), count.end() - 1);
+  for (int j = 0; j < M; ++j)
+    for (int e = A.p[j]; e < A.p[j + 1]; ++e) {
+      const int gi = group[A.i[e]], gj = group[j];
+      if (gi != gj) rows[next[std::max(gi, gj)]++] = std::min(gi, gj);
+    }
+  std::vector<int> cp(size_t(ngroups) + 1, 0), mark(ngroups, -1);
+  int nz = 0;
+  for (int g = 0; g < ngroups; ++g) {
+    for (int e = count[g]; e < count[g + 1]; ++e)
+      if (mark[rows[e]] != g) {
+        mark[rows[e]] = g;
+        rows[nz++] = rows[e];
+      }
+    cp[g + 1] = nz;
+  }
+  cholmod_sparse Q{};
+  Q.nrow = Q.ncol = static_cast<size_t>(ngroups);
+  Q.nzmax = static_cast<size_t>(std::max(nz, 1));
+  Q.p = cp.data();
+  Q.i = rows.data();
+  Q.stype = 1;
+  Q.itype = CHOLMOD_INT;
+  Q.xtype = CHOLMOD_PATTERN;
+  Q.dtype = CHOLMOD_DOUBLE;
+  Q.sorted = 0;
+  Q.packed = 1;
+  std::vector<int> gperm(ngroups);
+  if (!cholmod_amd(&Q, nullptr, 0, gperm.data(), &cc)) return false;
+  // Each group's unknowns in index order, the groups in AMD's order.
+  std::vector<int> gstart(size_t(ngroups) + 1, 0);
+  for (int j = 0; j < M; ++j) ++gstart[group[j] + 1];
+  for (int g = 0; g < ngroups; ++g) gstart[g + 1] += gstart[g];
+  std::vector<int> members(M);
+  next.assign(gstart.begin(), gstart.end() - 1);
+  for (int j = 0; j < M; ++j) members[next[group[j]]++] = j;
+  perm.clear();
+  for (const int g : gperm)
+    for (int e = gstart[g]; e < gstart[g + 1]; ++e) perm.push_back(members[e]);
+  return true;
+}
+
+void cholmod_solve_upper(const Csc& A, int M, const Eigen::MatrixXd& rhs, Eigen::MatrixXd& Y,
+                         const std::vector<int>& group, int ngroups) {
+  cholmod_serial_openmp();
+  thread_local CholmodCommon common;
+  cholmod_common& cc = common.c;
+  cholmod_sparse As{};
+  As.nrow = As.ncol = static_cast<size_t>(M);
+  As.nzmax = A.x.size();
+  As.p = const_cast<int*>(A.p.data());
+  As.i = const_cast<int*>(A.i.data());
+  As.x = const_cast<double*>(A.x.data());
+  As.stype = 1;  // upper triangle
+  As.itype = CHOLMOD_INT;
+  As.xtype = CHOLMOD_REAL;
+  As.dtype = CHOLMOD_DOUBLE;
+  As.sorted = 1;
+  As.packed = 1;
+  const auto failed = [&cc, M]() {
+    return std::runtime_error("fit: CHOLMOD failed with status " + std::to_string(cc.status) + " (" +
+                              std::to_string(M) + " unknowns)");
+  };
+  // The ordering: AMD on the quotient graph of `group` (grouped_amd), given to
+  // CHOLMOD, which follows it with its weighted postorder; AMD on A itself if
+  // that fails.
+  std::vector<int>& perm = csc_workspace().perm;
+  cholmod_factor* L = nullptr;
+  if (grouped_amd(A, M, group, ngroups, perm, cc)) {
+    cc.method[0].ordering = CHOLMOD_GIVEN;
+    L = cholmod_analyze_p(&As, perm.data(), nullptr, 0, &cc);
+    cc.method[0].ordering = CHOLMOD_AMD;
+  } else {
+    cc.status = CHOLMOD_OK;
+    L = cholmod_analyze(&As, &cc);
+  }
+  if (!L || cc.status < 0) {
+    if (L) cholmod_free_factor(&L, &cc);
+    throw failed();
+  }
+  cholmod_factorize(&As, L, &cc);
+  if (cc.status < 0) {
+    cholmod_free_factor(&L, &cc);
+    throw failed();
+  }
+  if (L->minor < L->n) {
+    cholmod_free_factor(&L, &cc);
+    throw std::runtime_error("fit: the normal matrix is not positive definite (" + std::to_string(M) +
+                             " unknowns)");
+  }
+  cholmod_dense B{};
+  B.nrow = static_cast<size_t>(M);
+  B.ncol = static_cast<size_t>(rhs.cols());
+  B.nzmax = B.nrow * B.ncol;
+  B.d = B.nrow;
+  B.x = const_cast<double*>(rhs.data());
+  B.xtype = CHOLMOD_REAL;
+  B.dtype = CHOLMOD_DOUBLE;
+  cholmod_dense* X = cholmod_solve(CHOLMOD_A, L, &B, &cc);
+  cholmod_free_factor(&L, &cc);
+  if (!X || cc.status < 0) {
+    if (X) cholmod_free_dense(&X, &cc);
+    throw failed();
+  }
+  Y = Eigen::Map<const Eigen::MatrixXd>(static_cast<const double*>(X->x), M, rhs.cols());
+  cholmod_free_dense(&X, &cc);
 }
 #endif
 
@@ -889,13 +1372,13 @@ JointSolution solve_joint(const FitData& d, const std::array<std::vector<double>
   std::vector<double> val(maxL);
 
   FitOptions::Solver solver = opt.solver;
-  // Auto: dense up to 1,300 unknowns, or up to 1,800 with 500,000 samples or
+  // Auto: dense up to 1,060 unknowns, or up to 1,800 with 500,000 samples or
   // more (the sparse assembly costs more per sample); measured crossovers with
-  // the banded-head dense Cholesky (docs/speed.md, "Dense against sparse"):
-  // 43,264 samples at about 1,270 unknowns (equal at 1,268), 1M samples
-  // between 1,640 and 2,046.
+  // the banded-head dense Cholesky (docs/speed.md, "Texture 32: the sparse
+  // path, round 3"): 43,264 samples between 1,022 and 1,098 unknowns (about
+  // 1,060 interpolated), 1M samples between 1,640 and 2,046.
   if (solver == FitOptions::Solver::Auto)
-    solver = M <= (N >= 500000 ? 1800 : 1300) ? FitOptions::Solver::Dense : FitOptions::Solver::Sparse;
+    solver = M <= (N >= 500000 ? 1800 : 1060) ? FitOptions::Solver::Dense : FitOptions::Solver::Sparse;
 
   // Residual targets g - fixed (a prefix holds them) and, for the objective
   // read off the normal equations, sum w r^2 per channel: both assembled paths.
@@ -920,12 +1403,11 @@ JointSolution solve_joint(const FitData& d, const std::array<std::vector<double>
   }
 
   if (solver == FitOptions::Solver::Sparse) {
-    using SpMat = SparseUpper;
-    SpMat A;
+    Csc& A = csc_workspace().A;
     Eigen::MatrixXd rhs;
-    assemble_sparse(d, r, terms, lookups, mu, prior, M, A, rhs);
-    // Each column's diagonal entry is its last (assemble_sparse).
-    const auto diag = [&A](int i) -> double& { return A.valuePtr()[A.outerIndexPtr()[i + 1] - 1]; };
+    assemble_sparse_csc(d, r, terms, lookups, mu, prior, M, A, rhs);
+    // Each column's diagonal entry is its last (assemble_sparse_csc).
+    const auto diag = [&A](int i) -> double& { return A.x[A.p[i + 1] - 1]; };
     double mean_diag = 0;
     for (int i = 0; i < M; ++i) mean_diag += diag(i);
     mean_diag /= std::max(M, 1);
@@ -937,27 +1419,19 @@ JointSolution solve_joint(const FitData& d, const std::array<std::vector<double>
     for (int i = 0; i < M; ++i) diag(i) += reg_diag;
 #ifdef BF_FACTOR_CHOLMOD
     // SuiteSparse's supernodal Cholesky (dense BLAS blocks on the supernodes),
-    // with AMD as the only ordering (CHOLMOD's default also tries METIS on
-    // larger matrices: AMD gives less fill here and costs less, docs/speed.md)
-    // and CHOLMOD's OpenMP regions serial (see cholmod_serial_openmp).
-    cholmod_serial_openmp();
-    Eigen::CholmodSupernodalLLT<SpMat, Eigen::Upper> llt;
-    cholmod_common& cc = llt.cholmod();
-    cc.nmethods = 1;
-    cc.method[0].ordering = CHOLMOD_AMD;
-    cc.postorder = 1;
-    cc.print = 0;  // no CHOLMOD messages on stdout: failures are thrown below
-    llt.compute(A);
-    if (cc.status < 0)
-      throw std::runtime_error("fit: CHOLMOD failed with status " + std::to_string(cc.status) + " (" +
-                               std::to_string(M) + " unknowns)");
+    // AMD ordering, CHOLMOD's OpenMP regions serial (cholmod_solve_upper).
+    std::vector<int>& group = csc_workspace().group;
+    const int ngroups = texel_pairs(terms, M, group);
+    cholmod_solve_upper(A, M, rhs, Y, group, ngroups);
 #else
-    Eigen::SimplicialLLT<SpMat, Eigen::Upper, Eigen::AMDOrdering<int>> llt(A);
-#endif
+    const Eigen::Map<const SparseUpper> Am(M, M, static_cast<int>(A.x.size()), A.p.data(), A.i.data(),
+                                           A.x.data());
+    Eigen::SimplicialLLT<SparseUpper, Eigen::Upper, Eigen::AMDOrdering<int>> llt(Am);
     if (llt.info() != Eigen::Success)
       throw std::runtime_error("fit: the normal matrix is not positive definite (" +
                                std::to_string(M) + " unknowns)");
     Y = llt.solve(rhs);
+#endif
     if (!exact_error) {
       // As the dense path: at the solution A y = rhs, so the data residual is
       // sum w r^2 - y.rhs - (regularization quadratic form at y); the gauge
@@ -1138,6 +1612,43 @@ std::vector<TermSpec> mccool_terms(int res) {
   TermSpec p{projection_first_pair(Parameterization::WiWo, res), true, std::nullopt};
   TermSpec q{projection_first_pair(Parameterization::HalfDiff, res), false, std::nullopt};
   return {p, q};
+}
+
+SparseNormal sparse_normal_equations(const FitData& d, const std::vector<TermSpec>& joint, const FitOptions& opt,
+                                     bool reference) {
+  opt.validate();
+  if (joint.empty()) throw std::invalid_argument("fit: no terms to solve");
+  std::vector<TermLayout> terms;
+  std::vector<std::array<Lookups, 2>> own(joint.size());
+  std::vector<const std::array<Lookups, 2>*> lookups;
+  int M = 0;
+  for (size_t i = 0; i < joint.size(); ++i) {
+    add_layout(d, joint[i], M, terms, own[i]);
+    lookups.push_back(&own[i]);
+  }
+  const std::array<std::vector<double>, 3> no_fixed{std::vector<double>(d.size(), 0.0),
+                                                    std::vector<double>(d.size(), 0.0),
+                                                    std::vector<double>(d.size(), 0.0)};
+  const Prior prior = extrapolation_prior(d, no_fixed, terms, lookups, M, opt);
+  const double mu = opt.smoothing * d.W / std::max(M, 1);
+  const std::array<const double*, 3> r = {d.g[0].data(), d.g[1].data(), d.g[2].data()};
+  SparseNormal out;
+  out.M = M;
+  if (reference) {
+    SparseUpper A;
+    assemble_sparse(d, r, terms, lookups, mu, prior, M, A, out.rhs);
+    A.makeCompressed();
+    out.p.assign(A.outerIndexPtr(), A.outerIndexPtr() + M + 1);
+    out.i.assign(A.innerIndexPtr(), A.innerIndexPtr() + A.nonZeros());
+    out.x.assign(A.valuePtr(), A.valuePtr() + A.nonZeros());
+  } else {
+    Csc A;
+    assemble_sparse_csc(d, r, terms, lookups, mu, prior, M, A, out.rhs);
+    out.p = std::move(A.p);
+    out.i = std::move(A.i);
+    out.x = std::move(A.x);
+  }
+  return out;
 }
 
 Eigen::MatrixXd joint_normal_matrix(const FitData& d, const std::vector<TermSpec>& joint, const FitOptions& opt,

@@ -65,9 +65,10 @@ struct FitOptions {
   // f <= A exp(max g) ~ the largest training value everywhere. Default on.
   bool clamp_log_range = true;
   // Dense: normal matrix assembled densely, LLT. Sparse: normal matrix assembled
-  // directly in compressed columns, CHOLMOD supernodal LLT with AMD (SimplicialLLT without CHOLMOD).
-  // Auto: dense up to 1,300 unknowns (1,800 with 500,000 samples or more), sparse above (measured
-  // crossovers, docs/speed.md "Sparse path"). ReferenceQR: the
+  // column by column in compressed columns, CHOLMOD supernodal LLT ordered by AMD on
+  // pairs of texels (SimplicialLLT with AMD without CHOLMOD).
+  // Auto: dense up to 1,060 unknowns (1,800 with 500,000 samples or more), sparse above (measured
+  // crossovers, docs/speed.md "Texture 32: the sparse path, round 3"). ReferenceQR: the
   // simple path (dense B, Householder QR, no normal equations) for tests.
   enum class Solver { Auto, Dense, Sparse, ReferenceQR } solver = Solver::Auto;
   // Throws std::invalid_argument naming the field, its value and the rule.
@@ -181,6 +182,22 @@ std::shared_ptr<HomomorphicFactorization> fit_homomorphic(
 // (nothing assembled). Throws std::invalid_argument as solve_joint does.
 Eigen::MatrixXd joint_normal_matrix(const FitData& d, const std::vector<TermSpec>& joint, const FitOptions& opt,
                                     size_t max_unknowns, size_t* unknowns = nullptr);
+
+// The sparse path's normal equations for `joint` alone (no fixed terms, the
+// targets d.g), before its gauge and ridge: A's upper triangle in compressed
+// columns (p: M + 1 column starts, i: rows, x: values; rows sorted, every
+// diagonal entry stored, hence last in its column) and rhs (M x 3), in
+// solve_joint's unknown layout. `reference`: the triplet assembly (Eigen's
+// setFromTriplets) the column-by-column assembly replaced, the simple path
+// tests compare it with. Throws std::invalid_argument as solve_joint does.
+struct SparseNormal {
+  int M = 0;
+  std::vector<int> p, i;
+  std::vector<double> x;
+  Eigen::MatrixXd rhs;
+};
+SparseNormal sparse_normal_equations(const FitData& d, const std::vector<TermSpec>& joint, const FitOptions& opt,
+                                     bool reference);
 
 // McCool's fixed projections (thesis 2.1.1): p(wi) and p(wo) share one texture
 // (a reciprocal wiwo term), q(h) has its own (halfdiff, first pair; h through

@@ -2,7 +2,8 @@
 // the normal matrix assembled directly in compressed columns, CHOLMOD or
 // Eigen's SimplicialLLT): the same solution as the dense path and the
 // reference QR path, with and without the extrapolation prior and with a
-// JointPrefix, and a matrix that is not positive definite reported.
+// JointPrefix, and a matrix that is not positive definite reported; the
+// column-by-column assembly against the triplet assembly it replaced.
 #include <cmath>
 #include <random>
 
@@ -126,6 +127,50 @@ TEST_CASE(
   opt.solver = FitOptions::Solver::ReferenceQR;
   const JointSolution ref = solve_joint(d, fixed, joint, opt);
   CHECK(rel_diff(plain.rel_mse, ref.rel_mse) < 1e-8);
+}
+
+TEST_CASE("sparse fit: the column-by-column assembly equals the triplet assembly") {
+  const bf_test::McCoolFormBrdf brdf;
+  const SampleSet s = sample_stratified(brdf, 2000, 53);
+  std::mt19937_64 rng(59);
+  std::uniform_int_distribution<int> res_of(5, 11), count_of(1, 3), coin(0, 1);
+  for (int layout = 0; layout < 12; ++layout) {
+    // Random layouts: 1 to 3 terms, each wiwo or halfdiff, reciprocal (wiwo)
+    // or not, of random resolutions; the prior on in every other layout.
+    std::vector<TermSpec> joint;
+    const int n = count_of(rng);
+    for (int t = 0; t < n; ++t) {
+      const bool wiwo = coin(rng) == 1;
+      joint.push_back({bf_test::random_projection(rng, wiwo ? Parameterization::WiWo : Parameterization::HalfDiff,
+                                                  res_of(rng)),
+                       wiwo && coin(rng) == 1, std::nullopt});
+    }
+    FitOptions opt;
+    opt.extrapolation_prior = layout % 2 == 1 ? 0.5 : 0.0;
+    const FitData d(s, opt.eps);
+    const SparseNormal ref = sparse_normal_equations(d, joint, opt, /*reference=*/true);
+    const SparseNormal col = sparse_normal_equations(d, joint, opt, /*reference=*/false);
+    INFO("layout " << layout << ": " << n << " terms, " << ref.M << " unknowns, prior "
+                   << opt.extrapolation_prior);
+    REQUIRE(col.M == ref.M);
+    // The same pattern, rows sorted and every diagonal entry last in its column.
+    REQUIRE(col.p == ref.p);
+    REQUIRE(col.i == ref.i);
+    for (int j = 0; j < col.M; ++j) {
+      REQUIRE(col.p[j + 1] > col.p[j]);
+      CHECK(col.i[col.p[j + 1] - 1] == j);
+      for (int e = col.p[j]; e + 1 < col.p[j + 1]; ++e) CHECK(col.i[e] < col.i[e + 1]);
+    }
+    // The same values up to summation order.
+    double scale = 0, worst = 0;
+    for (size_t e = 0; e < ref.x.size(); ++e) {
+      scale = std::max(scale, std::abs(ref.x[e]));
+      worst = std::max(worst, std::abs(col.x[e] - ref.x[e]));
+    }
+    CHECK(worst <= 1e-12 * scale);
+    const double rhs_scale = ref.rhs.cwiseAbs().maxCoeff();
+    CHECK((col.rhs - ref.rhs).cwiseAbs().maxCoeff() <= 1e-12 * rhs_scale);
+  }
 }
 
 TEST_CASE("sparse fit: a normal matrix that is not positive definite is reported") {
