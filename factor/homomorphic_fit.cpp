@@ -1372,13 +1372,13 @@ JointSolution solve_joint(const FitData& d, const std::array<std::vector<double>
   std::vector<double> val(maxL);
 
   FitOptions::Solver solver = opt.solver;
-  // Auto: dense up to 1,060 unknowns, or up to 1,800 with 500,000 samples or
-  // more (the sparse assembly costs more per sample); measured crossovers with
-  // the banded-head dense Cholesky (docs/speed.md, "Texture 32: the sparse
-  // path, round 3"): 43,264 samples between 1,022 and 1,098 unknowns (about
-  // 1,060 interpolated), 1M samples between 1,640 and 2,046.
-  if (solver == FitOptions::Solver::Auto)
-    solver = M <= (N >= 500000 ? 1800 : 1060) ? FitOptions::Solver::Dense : FitOptions::Solver::Sparse;
+  // Auto: dense up to 1,650 unknowns, or up to 2,200 with 500,000 samples or
+  // more (the sparse assembly costs more per sample); measured crossovers of
+  // the staircase dense Cholesky and the pair-ordered sparse path (docs/speed.md,
+  // "Dense against sparse, round 3"): 43,264 samples at about 1,640 unknowns
+  // (dense faster at 1,540, equal at 1,640, slower at 1,736), 1M samples
+  // between 2,046 and 2,516 (about 2,220 interpolated).
+    solver = M <= (N >= 500000 ? 2200 : 1650) ? FitOptions::Solver::Dense : FitOptions::Solver::Sparse;
 
   // Residual targets g - fixed (a prefix holds them) and, for the objective
   // read off the normal equations, sum w r^2 per channel: both assembled paths.

@@ -67,8 +67,8 @@ struct FitOptions {
   // Dense: normal matrix assembled densely, LLT. Sparse: normal matrix assembled
   // column by column in compressed columns, CHOLMOD supernodal LLT ordered by AMD on
   // pairs of texels (SimplicialLLT with AMD without CHOLMOD).
-  // Auto: dense up to 1,060 unknowns (1,800 with 500,000 samples or more), sparse above (measured
-  // crossovers, docs/speed.md "Texture 32: the sparse path, round 3"). ReferenceQR: the
+  // Auto: dense up to 1,650 unknowns (2,200 with 500,000 samples or more), sparse above (measured
+  // crossovers, docs/speed.md "Dense against sparse, round 3"). ReferenceQR: the
   // simple path (dense B, Householder QR, no normal equations) for tests.
   enum class Solver { Auto, Dense, Sparse, ReferenceQR } solver = Solver::Auto;
   // Throws std::invalid_argument naming the field, its value and the rule.
