@@ -192,6 +192,9 @@ void run_bench_fit(const BenchFitArgs& a) {
   j["solve_last"] = a.solve_last;
   j["reciprocity"] = a.reciprocity;
   j["solver"] = a.solver;
+  j["solver_used"] = sol.solver == FitOptions::Solver::Sparse        ? "sparse"
+                     : sol.solver == FitOptions::Solver::ReferenceQR ? "qr"
+                                                                      : "dense";
   j["unknowns"] = sol.unknowns;
   j["ms_median"] = median;
   j["ms_min"] = *std::min_element(ms.begin(), ms.end());

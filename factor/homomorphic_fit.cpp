@@ -1378,6 +1378,7 @@ JointSolution solve_joint(const FitData& d, const std::array<std::vector<double>
   // "Dense against sparse, round 3"): 43,264 samples at about 1,640 unknowns
   // (dense faster at 1,540, equal at 1,640, slower at 1,736), 1M samples
   // between 2,046 and 2,516 (about 2,220 interpolated).
+  if (solver == FitOptions::Solver::Auto)
     solver = M <= (N >= 500000 ? 2200 : 1650) ? FitOptions::Solver::Dense : FitOptions::Solver::Sparse;
 
   // Residual targets g - fixed (a prefix holds them) and, for the objective
@@ -1552,6 +1553,7 @@ JointSolution solve_joint(const FitData& d, const std::array<std::vector<double>
   // Residual: rel_mse of fixed + joint terms, with the reconstruction's clamping.
   JointSolution sol;
   sol.unknowns = static_cast<size_t>(M);
+  sol.solver = solver;
   if (!exact_error && quad_rel_mse >= 0) {
     sol.rel_mse = quad_rel_mse;
   } else {

@@ -125,6 +125,8 @@ struct JointSolution {
   // (unclamped), read off the normal equations in O(unknowns) (search loop).
   double rel_mse = 0;
   size_t unknowns = 0;            // texels solved for (all joint terms)
+  // The path that solved it: FitOptions::solver, or Auto's choice (Dense or Sparse).
+  FitOptions::Solver solver = FitOptions::Solver::Dense;
 };
 
 // Sum of the given (fixed) terms' log values at every sample, per channel.

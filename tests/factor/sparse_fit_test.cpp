@@ -63,6 +63,7 @@ TEST_CASE("sparse fit: equals the dense and reference QR paths on a planted reci
       for (int i = 0; i < 3; ++i) {
         opt.solver = solvers[i];
         sol[i] = solve_joint(d, zero, joint, opt, /*exact_error=*/true);
+        REQUIRE(sol[i].solver == solvers[i]);  // a forced path is the one taken
       }
       const double to_dense = worst_function_difference(d, sol[0], sol[1]);
       const double to_qr = worst_function_difference(d, sol[0], sol[2]);
@@ -127,6 +128,24 @@ TEST_CASE(
   opt.solver = FitOptions::Solver::ReferenceQR;
   const JointSolution ref = solve_joint(d, fixed, joint, opt);
   CHECK(rel_diff(plain.rel_mse, ref.rel_mse) < 1e-8);
+  CHECK(plain.solver == FitOptions::Solver::Sparse);
+  CHECK(pre.solver == FitOptions::Solver::Sparse);
+  CHECK(ref.solver == FitOptions::Solver::ReferenceQR);
+}
+
+TEST_CASE("sparse fit: Auto takes the dense path up to 1,650 unknowns and the sparse path above") {
+  const bf_test::McCoolFormBrdf brdf;
+  const SampleSet s = sample_stratified(brdf, 3000, 53);
+  const FitData d(s, FitOptions{}.eps);
+  std::array<std::vector<double>, 3> zero;
+  for (auto& z : zero) z.assign(d.size(), 0.0);
+  FitOptions opt;  // solver = Auto
+  std::mt19937_64 rng(59);
+  for (const int res : {8, 40}) {  // a few hundred unknowns; above 1,650 with two 40 x 40 textures
+    const JointSolution sol = solve_joint(d, zero, planted_terms(rng, res), opt, false);
+    INFO("texture " << res << ": " << sol.unknowns << " unknowns");
+    CHECK(sol.solver == (sol.unknowns <= 1650 ? FitOptions::Solver::Dense : FitOptions::Solver::Sparse));
+  }
 }
 
 TEST_CASE("sparse fit: the column-by-column assembly equals the triplet assembly") {
