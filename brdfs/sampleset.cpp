@@ -83,7 +83,7 @@ void evaluate_into(const Brdf& brdf, SampleSet& s) {
 }
 
 SampleSet sample_grid(const Brdf& brdf, int res) {
-  if (res > kMaxSampleGridResolution)
+  if (res < 2 || res > kMaxSampleGridResolution)
     throw std::invalid_argument("grid resolution: expected 2.." + std::to_string(kMaxSampleGridResolution) +
                                 " for a sample grid (res^4 pairs: 64 gives about 1e7), found " +
                                 std::to_string(res));

@@ -40,9 +40,8 @@ struct SampleSet {
 // Regular res^4 grid: res points per parabolic axis at cell centres
 // (-1 + (k + 0.5) * 2 / res), kept where both parabolic points lie in the unit
 // disk. res = 16 gives 208 directions per disk and 43,264 pairs.
-// Throws std::invalid_argument for res < 2 or res > 256.
-// Throws std::invalid_argument for res > kMaxSampleGridResolution (bounded
-// memory: about 1e7 pairs at 64).
+// Throws std::invalid_argument for res < 2 or res > kMaxSampleGridResolution
+// (bounded memory: about 1e7 pairs at 64).
 inline constexpr int kMaxSampleGridResolution = 64;
 SampleSet sample_grid(const Brdf& brdf, int res);
 // Directions of the res x res grid that lie in the disk (the per-disk set above).

@@ -64,7 +64,7 @@ TEST_CASE("config: each rule broken gives one message with file:line, field and 
   }
   SECTION("out of range") {
     require_one_config_error("[[brdf]]\npreset = \"bluepaint\"\n[sampling]\nresolution = 1\n[[method]]\nkind = \"mccool\"\n",
-                {"cfg.toml:4: sampling.resolution: expected an integer in 2..256, found 1"});
+                {"cfg.toml:4: sampling.resolution: expected an integer in 2..64, found 1"});
   }
   SECTION("float out of range") {
     require_one_config_error(std::string(kBase) + "[[method]]\nkind = \"mccool\"\neps = 0\n",
@@ -288,7 +288,7 @@ restarts = 6
     CHECK(p.methods[0].tolerance->value == 0.1);
   }
   SECTION("a bad overridden value is reported at the -D") {
-    require_one_config_error(text, {"-D sampling.resolution=1: sampling.resolution: expected an integer in 2..256, found 1"},
+    require_one_config_error(text, {"-D sampling.resolution=1: sampling.resolution: expected an integer in 2..64, found 1"},
                 {"sampling.resolution=1"});
   }
   SECTION("a key no method accepts") {
