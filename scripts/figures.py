@@ -82,21 +82,23 @@ def ratio(num, den):
 FIGURES = {
     "w1_mccool_rel_mse": ("w1_mccool", row("mccool", "rel_mse"), "%.3g", 0.005,
                           "W1: McCool's rel_mse (texture 16, default fit options)"),
-    "w1_greedy2_rel_mse": ("w1_search5", bench_line("greedy", "rel_mse_after_term", 1), "%.3g", 0.03,
-                           "W1: Cole's greedy search, 2 textures"),
-    "w1_greedy5_rel_mse": ("w1_search5", bench_line("greedy", "rel_mse_after_term", 4), "%.3g", 0.03,
-                           "W1: Cole's greedy search, 5 textures"),
-    "w1_struct2_rel_mse": ("w1_search5", bench_line("structured", "rel_mse_after_term", 1), "%.3g", 0.03,
-                           "W1: the structured search's 2-texture answer"),
-    "w1_struct5_rel_mse": ("w1_search5", bench_line("structured", "rel_mse_after_term", 4), "%.3g", 0.03,
-                           "W1: the structured search, 5 textures"),
+}
+for strategy, short, what in (("greedy", "greedy", "Cole's greedy search"),
+                              ("structured", "struct", "the structured search's answer")):
+    for k in range(1, 6):
+        FIGURES["w1_%s%d_rel_mse" % (short, k)] = (
+            "w1_search5", bench_line(strategy, "rel_mse_after_term", k - 1), "%.3g", 0.03,
+            "W1: %s, %d texture%s" % (what, k, "s" if k > 1 else ""))
+FIGURES.update({
     "w1_struct2_ratio": (None, ratio("w1_struct2_rel_mse", "w1_mccool_rel_mse"), "%.3g", 0.03,
                          "W1: structured 2 textures / McCool (like for like: both with today's defaults)"),
     "w1_struct5_ratio": (None, ratio("w1_struct5_rel_mse", "w1_mccool_rel_mse"), "%.3g", 0.03,
                          "W1: structured 5 textures / McCool"),
     "w1_greedy2_ratio": (None, ratio("w1_greedy2_rel_mse", "w1_mccool_rel_mse"), "%.3g", 0.03,
                          "W1: greedy 2 textures / McCool"),
-}
+    "w1_greedy5_ratio": (None, ratio("w1_greedy5_rel_mse", "w1_mccool_rel_mse"), "%.3g", 0.03,
+                         "W1: greedy 5 textures / McCool"),
+})
 for method, label in (("mccool", "McCool"), ("search", "search, 2 textures"), ("svd", "linear SVD, rank 2")):
     for column, fmt in (("rel_mse", "%.3g"), ("lin_rmse", "%.3g"), ("cos_rmse", "%.3g"),
                         ("shade_rmse", "%.3g"), ("storage_floats", "%d")):
@@ -197,6 +199,7 @@ def main():
             f.write(quick_table(values))
     bad = 0
     used = 0
+    seen = set()
     for path in doc_files():
         with open(path, encoding="utf-8") as f:
             text = f.read()
@@ -211,6 +214,7 @@ def main():
                 bad += 1
                 return m.group(0)
             used += 1
+            seen.add(key)
             fmt, tol = FIGURES[key][2], FIGURES[key][3]
             v = values[key]
             if a.write:
@@ -235,6 +239,11 @@ def main():
             with open(path, "w", encoding="utf-8") as f:
                 f.write(new)
     if a.check:
+        for key in FIGURES:
+            if key not in seen:
+                print("figures: figure '%s' appears in no doc (docs/quick-figures.md lists every figure: "
+                      "run scripts/figures.py --write)" % key)
+                bad += 1
         if bad:
             print("figures: %d figure(s) disagree with the docs: run scripts/figures.py --write and commit" % bad)
             return 1
