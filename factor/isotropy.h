@@ -1,4 +1,4 @@
-// Isotropy detection by an azimuthal-invariance test on samples (issue #7):
+// Isotropy detection by an azimuthal-invariance test on samples:
 // an isotropic BRDF is unchanged when wi and wo rotate together about the
 // normal, f(Rz(a) wi, Rz(a) wo) = f(wi, wo) for every angle a. The test draws
 // random pairs (wi, wo) on the upper hemisphere and random angles and records

@@ -1,4 +1,4 @@
-// Scene lighting for the SH baselines (issue #7 part B; notes
+// Scene lighting for the SH baselines (notes in
 // docs/design.md §9.4-9.5):
 //  - lat-long environment maps (.exr, or Radiance .hdr / .pic),
 //    projected onto real SH (solvers/sh.h convention) with exact quadrature
