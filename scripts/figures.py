@@ -6,7 +6,8 @@ minute is written between markers, invisible in rendered markdown:
 
     <!--fig:w1_mccool_rel_mse-->0.0686<!--/fig-->
 
-Every marker names a figure of the table FIGURES below, which says the command
+(figure names are lower case; an upper-case placeholder such as NAME in an
+example is not a marker). Every marker names a figure of the table FIGURES below, which says the command
 that measures it (a `brdf-factor` command line or a config run), how the value
 is read from its output, how it is printed and the relative tolerance of the
 check. Errors are deterministic for a build (seeded searches, fixed grids);
@@ -32,7 +33,7 @@ import sys
 import tempfile
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-MARKER = re.compile(r"<!--fig:([A-Za-z0-9_]+)-->(.*?)<!--/fig-->")
+MARKER = re.compile(r"<!--fig:([a-z0-9_]+)-->(.*?)<!--/fig-->")
 
 # Jobs: one command each; several figures read one job's output.
 # A job is ("bench", [args]) -> the JSON lines it prints, or
