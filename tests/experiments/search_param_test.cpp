@@ -186,3 +186,19 @@ TEST_CASE("search parameterization: the plots group a parameterization sweep by 
   INFO(read_text(tmp / "probe.txt"));
   CHECK(read_text(tmp / "probe.txt") == "ok\n");
 }
+
+TEST_CASE("search parameterization: bench search follows the config's rule") {
+  std::string out;
+  CHECK(run_cli("bench search --parameterization halfdiff --term-param either", &out) == 2);
+  CHECK(out.find("--term-param: either") != std::string::npos);
+  CHECK(out.find("--parameterization halfdiff") != std::string::npos);
+  // --parameterization alone fixes every term (McCool's form: the free search mixes).
+  REQUIRE(run_cli("bench search --brdf mccool-form --grid 6 --texture 6 --terms 2 --restarts 1 --threads 1 "
+                  "--parameterization wiwo",
+                  &out) == 0);
+  const auto line = out.find("{\"");
+  REQUIRE(line != std::string::npos);
+  const nlohmann::json j = nlohmann::json::parse(out.substr(line, out.find('\n', line) - line));
+  CHECK(j.at("term_param") == "fixed");
+  CHECK(j.at("term_parameterizations") == nlohmann::json::array({"wiwo", "wiwo"}));
+}
