@@ -280,6 +280,8 @@ nlohmann::json bench_one_search(const BenchSearchArgs& a, const FitData& d, cons
   j["strategy"] = strategy;
   j["brdf"] = a.brdf;
   j["parameterization"] = a.param;
+  j["term_param"] = a.term_param;
+  j["search_strategy"] = r.strategy;
   j["reciprocity"] = a.reciprocity;
   j["sampling"] = a.sampling;
   j["samples"] = d.size();
@@ -715,7 +717,8 @@ void add_cmd_bench(CLI::App& app) {
       ->check(CLI::IsMember({"structured", "greedy", "both"}))
       ->capture_default_str();
   search->add_option("--term-param", b->term_param,
-                     "structured: either (each term picks wiwo or halfdiff) or fixed (--parameterization)")
+                     "structured: either (each term picks wiwo or halfdiff) or fixed (--parameterization); "
+                     "default fixed when --parameterization is given, else either")
       ->check(CLI::IsMember({"either", "fixed"}))
       ->capture_default_str();
   search->add_option("--keep", b->keep, "structured: Powell runs per term (best screened starts)")
@@ -724,7 +727,19 @@ void add_cmd_bench(CLI::App& app) {
       ->capture_default_str();
   search->add_option("--polish-sweeps", b->polish_sweeps, "structured: joint re-search sweeps at the end")
       ->capture_default_str();
-  search->callback([b] { run_bench_search(*b); });
+  search->callback([b, search] {
+    // As in a config: an explicit --parameterization is every term's (fixed),
+    // and --term-param either with it is a contradiction, not an override.
+    const bool param_given = search->get_option("--parameterization")->count() > 0;
+    const bool term_param_given = search->get_option("--term-param")->count() > 0;
+    if (param_given && term_param_given && b->term_param == "either")
+      throw std::invalid_argument("--term-param: either lets the search choose each term's parameterization, which "
+                                  "contradicts --parameterization " + b->param +
+                                  "; expected --term-param fixed or no --term-param (every term reads "
+                                  "--parameterization), or no --parameterization (the search chooses per term)");
+    if (param_given && !term_param_given) b->term_param = "fixed";
+    run_bench_search(*b);
+  });
 
   auto* lines = bench->add_subcommand(
       "lines", "Golden section against Brent, line by line, on the first term's search objective");

@@ -41,7 +41,8 @@ const std::vector<std::string>& required_columns() {
 const std::vector<std::string>& result_columns() {
   static const std::vector<std::string> c = [] {
     std::vector<std::string> v = required_columns();
-    for (const char* e : {"label", "sampling", "sweep", "seed", "status", "errors_after_term", "negative_texels",
+    for (const char* e : {"label", "sampling", "sweep", "seed", "status", "errors_after_term",
+                          "search_strategy", "term_parameterizations", "negative_texels",
                           "order", "view_order", "tolerance", "tolerance_reached", "shade_rmse", "val_rel_mse",
                           "val_cos_rmse", "val_max_ratio", "holdout_rel_mse", "holdout_cos_rmse", "validation",
                           "flag", "isotropic",
@@ -57,7 +58,7 @@ const std::vector<std::string>& result_columns() {
 std::vector<std::string> display_columns(const std::vector<RunEntry>& runs) {
   std::vector<std::string> cols = required_columns();
   cols.insert(cols.begin() + 3, "label");
-  for (const char* extra : {"order", "view_order", "tolerance", "tolerance_reached", "shade_rmse", "val_rel_mse",
+  for (const char* extra : {"search_strategy", "term_parameterizations", "order", "view_order", "tolerance", "tolerance_reached", "shade_rmse", "val_rel_mse",
                             "val_cos_rmse", "val_max_ratio", "holdout_rel_mse", "holdout_cos_rmse", "flag", "refine",
                             "refine_seconds", "rel_mse_before", "lin_rmse_before", "cos_rmse_before", "seed",
                             "sampling", "sweep", "model", "notes"})

@@ -16,7 +16,9 @@ Writes into --out (default: plots/ beside the CSV), one file per figure:
                     which represent f cos, take part)
 
 What the figures promise:
-  - one series = one method label with one parameterization, reciprocity,
+  - one series = one method label with one requested parameterization
+    (the swept value or the `parameterization` column, never the terms'
+    `term_parameterizations`), reciprocity,
     sampling and value of every non-numeric swept option; each series has its
     own colour AND marker (the pair is distinct for up to 60 series);
   - a line joins points only along one swept numeric option, the others held
@@ -82,7 +84,10 @@ def series_name(r, axis_keys):
     """Legend name of a run's series: everything that tells it apart except the
     numeric swept options (axis_keys), which are positions along its lines."""
     parts = [label_of(r)]
-    p = r.get("parameterization")
+    # What the run asked for: a swept value, else the column (which, for a
+    # search, is the asked parameterization or "either"; the terms' own are in
+    # term_parameterizations and never split a series).
+    p = sweep_of(r).get("parameterization") or r.get("parameterization")
     if p and p not in parts[0]:
         parts.append(p)
     if r.get("reciprocity") == "true":

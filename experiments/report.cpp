@@ -148,7 +148,8 @@ void results_table(const ExperimentOutput& e, std::ostringstream& h) {
       const std::string cell = it == r.row.end() ? "" : it->second;
       const bool text = c == "run_id" || c == "brdf" || c == "method" || c == "label" || c == "parameterization" ||
                         c == "sampling" || c == "notes" || c == "reciprocity" || c == "sweep" ||
-                        c == "tolerance" || c == "flag";
+                        c == "tolerance" || c == "flag" || c == "search_strategy" ||
+                        c == "term_parameterizations";
       const bool best = marked.count({size_t(&r - e.runs.data()), c}) > 0;
       h << "<td" << (text ? " class=\"t\"" : best ? " class=\"best\" title=\"best " + esc(c) + " of this BRDF\"" : "")
         << ">";

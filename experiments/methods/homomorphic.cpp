@@ -157,21 +157,26 @@ MethodOutcome finish_homomorphic(const RunContext& c, HomomorphicRun run, std::o
 }
 
 std::vector<std::string> homomorphic_columns() {
-  return {"parameterization", "reciprocity", "terms", "texture_size", "errors_after_term"};
+  return {"parameterization", "reciprocity", "terms", "texture_size", "errors_after_term", "term_parameterizations"};
 }
 
+// Also term_parameterizations: each term's parameterization, in order. The
+// parameterization column is the terms' distinct ones; the search kind puts
+// what its options ask there instead.
 void fill_homomorphic_row(const RunContext& c, MethodOutcome& out, Row& row) {
   const auto& run = std::any_cast<const HomomorphicRun&>(out.state);
   const HomomorphicFactorization& h = *run.h;
-  std::vector<std::string> params;
+  std::vector<std::string> params, per_term;
   size_t recip = 0, symmetric = 0;
   for (const auto& t : h.terms()) {
+    per_term.push_back(to_string(t.proj.param));
     if (std::find(params.begin(), params.end(), to_string(t.proj.param)) == params.end())
       params.push_back(to_string(t.proj.param));
     recip += t.reciprocal;
     symmetric += t.reciprocal || t.proj.self_conjugate();
   }
   row["parameterization"] = join(params, "+");
+  row["term_parameterizations"] = join(per_term, "+");  // one entry per term, in order
   // true: every term is read through its conjugate or is its own conjugate
   // (McCool's p(h) texture), so the approximation is reciprocal.
   row["reciprocity"] = recip == 0 ? "false" : symmetric == h.terms().size() ? "true" : "mixed";

@@ -16,13 +16,23 @@ using nlohmann::json;
 
 namespace {
 
+KeySpec with_default(KeySpec k, std::string default_text) {
+  k.default_text = std::move(default_text);
+  return k;
+}
+
 const std::vector<KeySpec>& search_keys() {
   static const std::vector<KeySpec> keys = [] {
     std::vector<KeySpec> k = fit_keys(int_key("texture_size", 2, 1024, "16", "final resolution"));
     const auto r = refine_keys();
     k.insert(k.end(), r.begin(), r.end());
     const std::vector<KeySpec> own = {
-        choice_key("parameterization", {"wiwo", "halfdiff"}, "wiwo", ""),
+        with_default(choice_key("parameterization", {"wiwo", "halfdiff"}, "",
+                   "given (or swept): every term of every strategy reads it (`term_param = \"fixed\"`; "
+                   "`term_param = \"either\"` with it is an error). Not given: the greedy search reads wiwo and "
+                   "the structured search chooses wiwo or halfdiff per term; column `parameterization` then says "
+                   "`either` (greedy alone: `wiwo`). Column `term_parameterizations` lists each term's"),
+                     "none: the search's choice"),
         int_key("terms", 1, 64, "2; 8 with a tolerance", "textures to build; with a tolerance, the cap"),
         other_key("search_texture_size", "0 or 2..1024", "0", "resolution during the search; 0 = texture_size"),
         int_key("restarts", 0, 100000, "6", "seeded random starts per term"),
@@ -64,9 +74,10 @@ const std::vector<KeySpec>& search_keys() {
                    "the factorization with the lower rel_mse (run.json `search_strategy` says which; with a "
                    "tolerance the greedy search alone); refuses what `structured` refuses. Default `best`, or `greedy` when "
                    "`beam`, `backfit_sweeps`, `backfit_restarts` or `optimizer` is given. Measured in docs/search.md"),
-        choice_key("term_param", {"either", "fixed"}, "either",
-                   "structured: each term reads the wiwo or the halfdiff point as the search chooses (`either`), or "
-                   "every term reads `parameterization` (`fixed`)"),
+        with_default(choice_key("term_param", {"either", "fixed"}, "",
+                                "structured: each term reads the wiwo or the halfdiff point as the search chooses "
+                                "(`either`), or every term reads `parameterization` (`fixed`)"),
+                     "`\"fixed\"` when `parameterization` is given, else `\"either\"`"),
         int_key("keep", 1, 1000, "3", "structured: starts refined by Powell per term (the best by one fit each)"),
         int_key("polish_sweeps", 0, 1000, "2", "structured: final sweeps re-searching each term with the others held"),
         int_key("beam_width", 1, 1000, "8", "structured: partial configurations kept per term"),
@@ -138,6 +149,14 @@ void record_options(const MethodVariant& m, json& o) {
   if (s.backfit_sweeps != 0 && s.backfit_restarts != 0) o["backfit_restarts"] = s.backfit_restarts;
 }
 
+// The `parameterization` column of a search: what its options ask of every
+// term. "either": the structured search (alone or in "best") may choose wiwo
+// or halfdiff per term (no parameterization given); otherwise the one every
+// term reads. Column `term_parameterizations` says what each term read.
+std::string asked_parameterization(const SearchOptions& s) {
+  return s.strategy != "greedy" && s.term_param == "either" ? "either" : to_string(s.param);
+}
+
 json term_records(const SearchResult& sr) {
   json terms = json::array();
   for (const auto& t : sr.terms)
@@ -170,6 +189,16 @@ class SearchKind final : public HomomorphicKind {
   bool array_is_value(const std::string& key, const toml::array& a) const override {
     return key == "guesses" && !all_arrays(a);
   }
+  std::vector<std::string> columns() const override {
+    std::vector<std::string> c = homomorphic_columns();
+    c.push_back("search_strategy");
+    return c;
+  }
+  void fill_row(const RunContext& c, MethodOutcome& out, Row& row) const override {
+    fill_homomorphic_row(c, out, row);
+    row["parameterization"] = asked_parameterization(c.method.search);
+    row["search_strategy"] = out.record.value("search_strategy", "");
+  }
 
   void read(Reader& r, MethodVariant& m, json& o, uint64_t base_seed) const override {
     read_refine_options(r, m, o);
@@ -180,13 +209,22 @@ class SearchKind final : public HomomorphicKind {
     const bool greedy_keys =
         r.has("beam") || r.has("backfit_sweeps") || r.has("backfit_restarts") || r.has("optimizer");
     s.strategy = r.choice(key("strategy"), greedy_keys ? "greedy" : "best");
-    s.term_param = r.choice(key("term_param"), s.term_param);
+    // An explicit parameterization (or a sweep over it) is every term's: the
+    // structured search then reads no other point. Without it the structured
+    // search chooses per term (the documented default).
+    const bool param_given = r.has("parameterization");
+    s.term_param = r.choice(key("term_param"), param_given ? "fixed" : "either");
     s.keep = static_cast<int>(r.integer(key("keep"), s.keep));
     s.polish_sweeps = static_cast<int>(r.integer(key("polish_sweeps"), s.polish_sweeps));
     s.beam_width = static_cast<int>(r.integer(key("beam_width"), s.beam_width));
     s.final_joint = r.boolean(key("final_joint"), s.final_joint);
     s.joint_polish_terms = static_cast<int>(r.integer(key("joint_polish_terms"), s.joint_polish_terms));
     m.param = read_param(r, "parameterization", s.param);
+    if (param_given && r.has("term_param") && s.term_param == "either")
+      r.fail("term_param", "term_param = \"either\" lets the search choose each term's parameterization, which "
+                           "contradicts the explicit parameterization = \"" + to_string(m.param) +
+                           "\"; expected term_param = \"fixed\" or no term_param (with parameterization every "
+                           "term reads it), or no parameterization (the search chooses per term)");
     m.tolerance = read_tolerance(r, o);
     // With a tolerance, `terms` is the cap (default 8): the greedy search stops
     // at the first term whose refit reaches the target.
@@ -270,6 +308,9 @@ class SearchKind final : public HomomorphicKind {
     MethodOutcome out = finish_homomorphic(c, std::move(run), std::move(chosen), sr.evaluations);
     out.record["terms"] = term_records(sr);
     out.record["search_strategy"] = sr.strategy;
+    json term_params = json::array();
+    for (const FactorTerm& t : sr.factorization->terms()) term_params.push_back(to_string(t.proj.param));
+    out.record["term_parameterizations"] = term_params;
     // The structured search's k-term answers (errors_after_term[k-1] is the
     // error of answers[k-1], which need not be a prefix of the row's factorization).
     if (!sr.answers.empty()) {

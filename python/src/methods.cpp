@@ -327,7 +327,10 @@ Cole's automatic factorization (Powell search over 4D rotations); with
 strategy="structured" the search of docs/search.md. Options: the keys of
 kind = "search" (strategy, terms, parameterization, texture_size,
 search_texture_size, restarts, guesses, optimizer, threads, seed, beam,
-tolerance, the fit and refinement keys, ...).)doc");
+tolerance, the fit and refinement keys, ...). An explicit parameterization is
+every term's (term_param "fixed"); without it the structured search chooses
+per term. info["term_parameterizations"] and info["search_strategy"] say what
+each term read and which strategy won.)doc");
   on_brdf("svd", "svd", R"doc(svd(brdf, samples=None, **options) -> Factorization
 
 Kautz-McCool SVD of the tabulated BRDF. Options: the keys of kind = "svd"

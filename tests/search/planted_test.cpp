@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <random>
+#include <set>
 
 #include "brdfs/catalogue.h"
 #include "brdfs/sampleset.h"
@@ -365,4 +366,41 @@ TEST_CASE("structured search: every k-term answer is no worse than the greedy k-
   // measured BRDFs and term counts where the greedy search is better.
   const PlantedProductBrdf b = planted_rotation_brdf(0, 2, Parameterization::WiWo);
   check_k_term_answers(sample_grid(b, 10), 2, 8, false);
+}
+
+TEST_CASE("structured search: term_param fixed puts every term and every k-term answer on the given parameterization") {
+  // McCool's form mixes wiwo and halfdiff: with term_param = "either" the
+  // structured search reads both points (the control), with "fixed" none of
+  // its starts, refinements, polish moves or k-term answers may read the other.
+  const PlantedProductBrdf b = planted_mccool_brdf(0);
+  const SampleSet s = sample_grid(b, 6);
+  const FitData d(s, 1e-5);
+  const auto params_of = [](const HomomorphicFactorization& f) {
+    std::set<Parameterization> out;
+    for (const FactorTerm& t : f.terms()) out.insert(t.proj.param);
+    return out;
+  };
+  SearchOptions either = structured(2, 6);
+  either.restarts = 2;
+  const SearchResult mixed = search_factorization(d, either);
+  CHECK(params_of(*mixed.factorization).size() == 2);  // the control: "either" does choose per term
+  // "best" with halfdiff: its greedy half reads `param` too, not wiwo.
+  for (const auto& [p, strategy] : std::vector<std::pair<Parameterization, std::string>>{
+           {Parameterization::WiWo, "structured"},
+           {Parameterization::HalfDiff, "structured"},
+           {Parameterization::HalfDiff, "best"}}) {
+    SearchOptions opt = structured(2, 6);
+    opt.strategy = strategy;
+    opt.restarts = 2;
+    opt.term_param = "fixed";
+    opt.param = p;
+    const SearchResult r = search_factorization(d, opt);
+    INFO(strategy << " " << to_string(p) << ", won by " << r.strategy);
+    CHECK(params_of(*r.factorization) == std::set<Parameterization>{p});
+    CHECK(r.factorization->terms().size() == 2);
+    for (const auto& a : r.answers) {
+      REQUIRE(a);
+      CHECK(params_of(*a) == std::set<Parameterization>{p});
+    }
+  }
 }

@@ -1,0 +1,204 @@
+// The search's parameterization: an explicit `parameterization` (or a sweep
+// over it) is every term's, whatever the strategy; without it the structured
+// search chooses per term. results.csv, results.md and report.html say what was
+// asked (`parameterization`), what each term read (`term_parameterizations`)
+// and which strategy made the row (`search_strategy`).
+#include <map>
+#include <set>
+
+#include "experiments/outputs.h"
+#include "experiments_helpers.h"
+#include "factor/export.h"
+
+using namespace bf;
+using namespace bf_test;
+
+namespace {
+
+// Small and fast, and of McCool's form p(wi) q(h) p(wo): the structured search
+// mixes wiwo and halfdiff terms on it when allowed to (the control below
+// checks that it does).
+const char* const kSweepConfig = R"([experiment]
+name = "param"
+seed = 1
+render = false
+
+[[brdf]]
+model = "mccool-form"
+
+[sampling]
+kind = "grid"
+resolution = 6
+
+[[method]]
+kind = "search"
+label = "asked"
+parameterization = ["wiwo", "halfdiff"]
+terms = 2
+texture_size = 6
+restarts = 1
+threads = 1
+
+[[method]]
+kind = "search"
+label = "free"
+terms = 2
+texture_size = 6
+restarts = 1
+threads = 1
+)";
+
+std::vector<std::string> split_plus(const std::string& s) {
+  std::vector<std::string> out;
+  size_t a = 0;
+  while (true) {
+    const size_t b = s.find('+', a);
+    out.push_back(s.substr(a, b == std::string::npos ? std::string::npos : b - a));
+    if (b == std::string::npos) return out;
+    a = b + 1;
+  }
+}
+
+// Each term's parameterization as exported (the factorization itself, not a column).
+std::vector<std::string> exported_params(const fs::path& out, const std::string& run_id) {
+  const auto f = load_factorization((out / "runs" / run_id / "factors.json").string());
+  const auto* h = dynamic_cast<const HomomorphicFactorization*>(f.get());
+  REQUIRE(h);
+  std::vector<std::string> p;
+  for (const FactorTerm& t : h->terms()) p.push_back(to_string(t.proj.param));
+  return p;
+}
+
+}  // namespace
+
+TEST_CASE("search parameterization: a sweep over wiwo and halfdiff gives rows whose every term reads the asked one") {
+  ScratchDir tmp;
+  const std::string cfg = write_text(tmp / "param.toml", kSweepConfig);
+  const fs::path out = tmp.path / "out";
+  const RunSummary sum = run_quiet(cfg, out.string());
+  REQUIRE(sum.failed == 0);
+  const auto rows = read_results_csv((out / "results.csv").string());
+  REQUIRE(rows.size() == 3);
+  std::map<std::string, int> asked;
+  bool free_mixed = false;
+  for (const auto& r : rows) {
+    INFO(r.at("label") << " " << r.at("sweep") << ": parameterization " << r.at("parameterization")
+                       << ", terms " << r.at("term_parameterizations") << ", strategy " << r.at("search_strategy"));
+    const std::vector<std::string> terms = split_plus(r.at("term_parameterizations"));
+    CHECK(terms.size() == 2);
+    CHECK(terms == exported_params(out, r.at("run_id")));  // the column is the factorization's truth
+    CHECK((r.at("search_strategy") == "greedy" || r.at("search_strategy") == "structured"));
+    if (r.at("label") == "asked") {
+      const std::string p = r.at("parameterization");
+      CHECK(r.at("sweep") == "parameterization=" + p);
+      ++asked[p];
+      for (const std::string& t : terms) CHECK(t == p);
+    } else {
+      // No key: the search may choose per term, and the column says so.
+      CHECK(r.at("parameterization") == "either");
+      for (const std::string& t : terms) CHECK((t == "wiwo" || t == "halfdiff"));
+      free_mixed = std::set<std::string>(terms.begin(), terms.end()).size() == 2;
+    }
+  }
+  CHECK(asked == std::map<std::string, int>{{"wiwo", 1}, {"halfdiff", 1}});
+  // The control: on this case the free search does mix, so "every term reads
+  // the asked one" above is not true by accident.
+  CHECK(free_mixed);
+  // The columns reach results.md and report.html.
+  const std::string md = read_text((out / "results.md").string());
+  const std::string html = read_text((out / "report.html").string());
+  for (const std::string& col : {"search_strategy", "term_parameterizations"}) {
+    CHECK(md.find(col) != std::string::npos);
+    CHECK(html.find("<th>" + col + "</th>") != std::string::npos);
+  }
+  CHECK(html.find(">halfdiff+halfdiff<") != std::string::npos);
+}
+
+TEST_CASE("search parameterization: the options say fixed exactly when the key is given") {
+  register_loaders();
+  const Plan plan = parse_plan(std::string(kConfigHead) +
+                                   "[[method]]\nkind = \"search\"\nparameterization = [\"wiwo\", \"halfdiff\"]\n"
+                                   "[[method]]\nkind = \"search\"\n"
+                                   "[[method]]\nkind = \"search\"\nterm_param = \"fixed\"\n"
+                                   "[[method]]\nkind = \"search\"\nstrategy = \"structured\"\n"
+                                   "parameterization = \"halfdiff\"\nterm_param = \"fixed\"\n",
+                               "cfg.toml");
+  REQUIRE(plan.methods.size() == 5);
+  CHECK(plan.methods[0].search.term_param == "fixed");
+  CHECK(plan.methods[0].search.param == Parameterization::WiWo);
+  CHECK(plan.methods[1].search.term_param == "fixed");
+  CHECK(plan.methods[1].search.param == Parameterization::HalfDiff);
+  CHECK(plan.methods[2].search.term_param == "either");  // no key: the search chooses
+  CHECK(plan.methods[3].search.term_param == "fixed");
+  CHECK(plan.methods[3].search.param == Parameterization::WiWo);
+  CHECK(plan.methods[4].search.term_param == "fixed");
+  CHECK(plan.methods[4].search.param == Parameterization::HalfDiff);
+  // The run id tells a fixed search from a free one.
+  CHECK(plan.methods[0].options.dump() != plan.methods[2].options.dump());
+}
+
+TEST_CASE("search parameterization: term_param either with an explicit parameterization is refused, naming both keys") {
+  for (const std::string strategy : {"", "strategy = \"structured\"\n", "strategy = \"greedy\"\n"}) {
+    INFO(strategy);
+    require_one_config_error(std::string(kConfigHead) + "[[method]]\nkind = \"search\"\n" + strategy +
+                                 "parameterization = \"halfdiff\"\nterm_param = \"either\"\n",
+                             {"cfg.toml:", "method[0].term_param", "parameterization = \"halfdiff\"",
+                              "term_param = \"either\"", "expected"});
+  }
+  // A sweep: each combination with the key is refused the same way.
+  const auto errs = config_errors(std::string(kConfigHead) + "[[method]]\nkind = \"search\"\n"
+                                                              "parameterization = [\"wiwo\", \"halfdiff\"]\n"
+                                                              "term_param = \"either\"\n");
+  REQUIRE(!errs.empty());
+  for (const auto& e : errs) CHECK(e.find("term_param") != std::string::npos);
+}
+
+TEST_CASE("search parameterization: the plots group a parameterization sweep by the asked value") {
+  const std::string py = find_python(nullptr);
+  INFO("no python3 with matplotlib (scripts/install-deps.sh installs python3-matplotlib)");
+  REQUIRE(!py.empty());
+  ScratchDir tmp;
+  // Rows of one sweep whose terms read other points than asked (a results.csv
+  // of a version that let the search choose, or a column of the terms' own):
+  // still one series per asked value, never one per chosen set.
+  const std::string probe =
+      "import sys; sys.path.insert(0, '" + fs::path(plot_script_path()).parent_path().string() +
+      "'); import plot_results as p\n"
+      "rows = [\n"
+      "  {'label': 's', 'parameterization': 'wiwo+halfdiff', 'term_parameterizations': 'wiwo+halfdiff',\n"
+      "   'sweep': 'parameterization=wiwo terms=2'},\n"
+      "  {'label': 's', 'parameterization': 'wiwo', 'term_parameterizations': 'wiwo+wiwo',\n"
+      "   'sweep': 'parameterization=wiwo terms=3'},\n"
+      "  {'label': 's', 'parameterization': 'halfdiff', 'term_parameterizations': 'halfdiff+halfdiff',\n"
+      "   'sweep': 'parameterization=halfdiff terms=2'},\n"
+      "  {'label': 's', 'parameterization': 'wiwo+halfdiff', 'term_parameterizations': 'halfdiff+wiwo',\n"
+      "   'sweep': 'parameterization=halfdiff terms=3'},\n"
+      "  {'label': 'f', 'parameterization': 'either', 'term_parameterizations': 'halfdiff+wiwo', 'sweep': 'terms=2'},\n"
+      "  {'label': 'f', 'parameterization': 'either', 'term_parameterizations': 'wiwo+wiwo', 'sweep': 'terms=3'},\n"
+      "]\n"
+      "names = [p.series_name(r, {'terms'}) for r in rows]\n"
+      "assert names[0] == names[1] and names[2] == names[3] and names[0] != names[2], names\n"
+      "assert 'wiwo' in names[0] and 'halfdiff' in names[2], names\n"
+      "assert names[4] == names[5] and len(set(names)) == 3, names\n"
+      "print('ok')\n";
+  write_text(tmp / "probe.py", probe);
+  CHECK(std::system((py + " " + (tmp / "probe.py") + " > " + (tmp / "probe.txt") + " 2>&1").c_str()) == 0);
+  INFO(read_text(tmp / "probe.txt"));
+  CHECK(read_text(tmp / "probe.txt") == "ok\n");
+}
+
+TEST_CASE("search parameterization: bench search follows the config's rule") {
+  std::string out;
+  CHECK(run_cli("bench search --parameterization halfdiff --term-param either", &out) == 2);
+  CHECK(out.find("--term-param: either") != std::string::npos);
+  CHECK(out.find("--parameterization halfdiff") != std::string::npos);
+  // --parameterization alone fixes every term (McCool's form: the free search mixes).
+  REQUIRE(run_cli("bench search --brdf mccool-form --grid 6 --texture 6 --terms 2 --restarts 1 --threads 1 "
+                  "--parameterization wiwo",
+                  &out) == 0);
+  const auto line = out.find("{\"");
+  REQUIRE(line != std::string::npos);
+  const nlohmann::json j = nlohmann::json::parse(out.substr(line, out.find('\n', line) - line));
+  CHECK(j.at("term_param") == "fixed");
+  CHECK(j.at("term_parameterizations") == nlohmann::json::array({"wiwo", "wiwo"}));
+}
