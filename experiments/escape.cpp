@@ -107,6 +107,7 @@ std::string script_json(const nlohmann::json& j) {
     if (c == '<') o += "\\u003c";
     else if (c == '>') o += "\\u003e";
     else if (c == '&') o += "\\u0026";
+    else if (c == '\'') o += "\\u0027";
     else if (c == '\xE2' && i + 2 < t.size() && t[i + 1] == '\x80' && (t[i + 2] == '\xA8' || t[i + 2] == '\xA9')) {
       o += t[i + 2] == '\xA8' ? "\\u2028" : "\\u2029";
       i += 2;

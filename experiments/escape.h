@@ -32,8 +32,8 @@ std::string url_path(const std::string& rel);
 std::string html_text(const std::string& s);
 
 // JSON for a <script> element of an HTML page (or a .js file): nlohmann's
-// dump with invalid UTF-8 replaced by U+FFFD, then < > & and U+2028/U+2029
-// written as \u003c \u003e \u0026 \u2028 \u2029. They occur only inside JSON
+// dump with invalid UTF-8 replaced by U+FFFD, then < > & ' and U+2028/U+2029
+// written as \u003c \u003e \u0026 \u0027 \u2028 \u2029. They occur only inside JSON
 // strings, so the value parses back unchanged, and "</script", "<!--" and
 // "<script" can never appear in the text.
 std::string script_json(const nlohmann::json& j);
