@@ -9,6 +9,7 @@
 
 #include "experiments/cli_util.h"
 #include "experiments/outdir_lock.h"
+#include "experiments/plot_step.h"
 #include "experiments/runner.h"
 
 namespace bf {
@@ -117,6 +118,7 @@ RunSummary merge_experiments(const std::vector<std::string>& dirs, const std::st
   if (!quiet) err << "merge: " << o.runs.size() << " runs from " << dirs.size() << " shard folders -> " << out_dir << "\n";
   sum.files = write_experiment_outputs(o, quiet ? nullptr : &err);
   print_output_paths(out, sum.files);
+  if (const std::string p = plot_failure(sum.files); !p.empty()) throw std::runtime_error(p);  // tables written
   return sum;
 }
 

@@ -18,9 +18,12 @@
 #include <iomanip>
 #include <sstream>
 #include <stdexcept>
+#include <sys/wait.h>
 #include <toml++/toml.h>
 
 #include "experiments/cli_util.h"
+#include "experiments/escape.h"
+#include "experiments/plot_step.h"
 #include "experiments/report.h"
 #include "experiments/validation.h"
 #include "factor/image_io.h"
@@ -195,6 +198,15 @@ std::string trim(std::string s) {
   return s;
 }
 
+// The first 1 MiB of a file ("" when it cannot be read).
+std::string read_text_prefix(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::string s(size_t(1) << 20, '\0');
+  in.read(s.data(), std::streamsize(s.size()));
+  s.resize(size_t(in.gcount()));
+  return s;
+}
+
 }  // namespace
 
 json software_versions() {
@@ -260,28 +272,23 @@ std::string now_iso() {
   return buf;
 }
 
-std::string md_cell(const std::string& s) {
-  std::string o;
-  for (char c : s) o += (c == '|') ? std::string("\\|") : std::string(1, c);
-  return o;
-}
-
 void write_results_md(const ExperimentOutput& e, const OutputFiles& f, const std::string& path) {
   const json& x = e.experiment;
   write_file_if_changed(path, [&](std::ostream& o) {  // unchanged: file and mtime kept
-    o << "# Experiment " << x.value("name", "") << "\n\n";
-    if (!x.value("description", "").empty()) o << x.value("description", "") << "\n\n";
+    // Text of user origin through md_text / md_code / url_path (escape.h).
+    o << "# Experiment " << md_text(x.value("name", "")) << "\n\n";
+    if (!x.value("description", "").empty()) o << md_text(x.value("description", "")) << "\n\n";
     size_t failed = 0;
     for (const auto& r : e.runs) failed += r.status != "ok";
-    o << "- config: [config.toml](config.toml) (from `" << e.config_path << "`)";
-    for (const auto& d : e.defines) o << ", `-D " << d << "`";
+    o << "- config: [config.toml](config.toml) (from " << md_code(e.config_path) << ")";
+    for (const auto& d : e.defines) o << ", " << md_code("-D " + d);
     o << "\n- runs: " << e.runs.size() << " in this folder";
     if (e.shards > 1) o << " (shard " << e.shard << "/" << e.shards << " of " << e.plan.size() << ")";
     if (!e.merged_from.empty()) o << " (merged from " << e.merged_from.size() << " shard folders)";
     if (failed) o << ", **" << failed << " failed**";
-    o << "\n- seed: " << x.value("seed", json(1)).dump() << " (per-run seeds in manifest.json)\n";
+    o << "\n- seed: " << md_text(x.value("seed", json(1)).dump()) << " (per-run seeds in manifest.json)\n";
     o << "- errors: docs/design.md §4 on each run's samples (log transform eps "
-      << x.value("metric_eps", json(1e-5)).dump() << "); `seconds` is the method's wall time\n";
+      << md_text(x.value("metric_eps", json(1e-5)).dump()) << "); `seconds` is the method's wall time\n";
     o << "- validation: `val_*` on a stratified whole-domain set against the BRDF (measured: its interpolant), "
          "`holdout_*` on raw samples held out of the fit, `shade_rmse` in the scene (docs/design.md §4.1); "
          "`flag`: validation error > "
@@ -302,20 +309,20 @@ void write_results_md(const ExperimentOutput& e, const OutputFiles& f, const std
       o << "|";
       for (const auto& c : cols) {
         auto it = r.row.find(c);
-        std::string cell = it == r.row.end() ? "" : it->second;
-        if (c == "run_id" && r.status == "ok") cell = "[" + cell + "](runs/" + cell + "/run.json)";
-        else if (c != "run_id") cell = format_short(cell);
-        if (!cell.empty() && marked.count({size_t(&r - e.runs.data()), c})) cell = "**" + cell + "**";
-        o << " " << md_cell(cell) << " |";
+        const std::string cell = it == r.row.end() ? "" : it->second;
+        std::string shown = md_text(c == "run_id" ? cell : format_short(cell));
+        if (c == "run_id" && r.status == "ok") shown = "[" + shown + "](runs/" + url_path(cell) + "/run.json)";
+        if (!cell.empty() && marked.count({size_t(&r - e.runs.data()), c})) shown = "**" + shown + "**";
+        o << " " << shown << " |";
       }
       o << "\n";
     }
     if (!f.plots.empty()) {
       o << "\n## Plots\n\n";
       for (const auto& p : f.plots)
-        if (p.size() > 4 && p.substr(p.size() - 4) == ".png") o << "![" << p << "](" << p << ")\n\n";
+        if (p.size() > 4 && p.substr(p.size() - 4) == ".png") o << "![" << md_text(p) << "](" << url_path(p) << ")\n\n";
     } else if (!f.plots_note.empty()) {
-      o << "\nPlots: " << f.plots_note << "\n";
+      o << "\nPlots: " << md_text(f.plots_note) << "\n";
     }
   });
 }
@@ -343,7 +350,9 @@ OutputFiles write_experiment_outputs(const ExperimentOutput& e, std::ostream* lo
   for (const auto& r : e.runs) rows.push_back(r.row);
   write_results_csv(f.results_csv, rows);
 
-  // Plots.
+  // Plots. plots.log is kept only when the script fails (plot_step.h).
+  std::error_code log_ec;
+  fs::remove(dir / "plots.log", log_ec);
   if (!e.plots) {
     f.plots_note = "not requested (plots = false or --no-plots)";
   } else if (e.runs.empty()) {
@@ -357,12 +366,30 @@ OutputFiles write_experiment_outputs(const ExperimentOutput& e, std::ostream* lo
     } else if (!fs::exists(script)) {
       f.plots_note = "plot script not found at " + script + " (set BRDF_FACTOR_PLOT_SCRIPT)";
     } else {
+      // stdout: the "wrote" lines; stderr (a traceback) to plots.log, and one
+      // line of it (the exception) in the note, the error and the tables.
       int st = 0;
+      const std::string log_path = (dir / "plots.log").string();
       const std::string cmd = shell_quote(py) + " " + shell_quote(script) + " " + shell_quote(f.results_csv) +
-                              " --out " + shell_quote((dir / "plots").string()) + " 2>&1";
+                              " --out " + shell_quote((dir / "plots").string()) + " 2> " + shell_quote(log_path);
       const std::string outp = run_capture(cmd, &st);
+      std::error_code ec;
+      if (st == 0) fs::remove(log_path, ec);
       if (st != 0) {
-        f.plots_note = "plot_results.py failed: " + trim(outp);
+        std::string last;  // the last non-empty line of stderr, else of stdout
+        for (const std::string& text : {outp, read_text_prefix(log_path)}) {
+          std::istringstream ss(text);
+          for (std::string line; std::getline(ss, line);)
+            if (!trim(line).empty()) last = trim(line);
+        }
+        for (char& c : last)
+          if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = ' ';
+        if (last.size() > 300) last = last.substr(0, 300) + "...";
+        const std::string status = WIFEXITED(st)     ? "exit status " + std::to_string(WEXITSTATUS(st))
+                                   : WIFSIGNALED(st) ? "killed by signal " + std::to_string(WTERMSIG(st))
+                                                     : "status " + std::to_string(st);
+        f.plots_note = script + " failed (" + status + ")" + (last.empty() ? "" : ": " + last) +
+                       " (its output: plots.log)";
       } else {
         std::istringstream ss(outp);
         std::string line;
@@ -406,6 +433,12 @@ OutputFiles write_experiment_outputs(const ExperimentOutput& e, std::ostream* lo
   f.report = (dir / "report.html").string();
   write_report_html(e, f, f.report);
   return f;
+}
+
+std::string plot_failure(const OutputFiles& f) {
+  std::error_code ec;
+  if (f.results_md.empty() || !fs::exists(fs::path(f.results_md).parent_path() / "plots.log", ec)) return "";
+  return "plots: " + f.plots_note + "; the tables are written: " + f.results_md;
 }
 
 ExperimentOutput read_experiment_manifest(const std::string& dir) {

@@ -26,7 +26,10 @@ What the figures promise:
   - the Pareto front (no other run of that BRDF has both less x and less error)
     is a dashed black step line, computed per BRDF only;
   - log axes get labelled ticks at 1-2-5 steps (or decades) chosen so that
-    there are 3 to 8 of them and they do not overlap.
+    there are 3 to 8 of them and they do not overlap;
+  - text from the results (BRDF names, labels, swept values, the metric) is
+    drawn as plain text: no mathtext, no TeX, whatever `$`, a backslash, `_`, `^`,
+    `%` or `{` it holds, and a leading `_` does not hide a legend entry.
 
 Plots are redrawn only when their inputs changed: a SHA-256 of the CSV, this
 script and the arguments is kept in OUT/.plot-inputs.json with the files it
@@ -110,6 +113,23 @@ def numeric_sweep_keys(rows):
             if number(v) is None:
                 keys[k] = False
     return [k for k, ok in keys.items() if ok]
+
+
+def plain(text):
+    """Draws a matplotlib Text as the characters it holds: no mathtext (a `$`
+    in a label would start it, and a lone one raises), no TeX."""
+    text.set_usetex(False)
+    if hasattr(text, "set_parse_math"):  # matplotlib >= 3.5
+        text.set_parse_math(False)
+    else:
+        text.set_text(text.get_text().replace("$", r"\$"))
+    return text
+
+
+def legend_label(name):
+    """A series name as a legend label: matplotlib leaves out labels that start
+    with '_', so such a name gets a leading space."""
+    return " " + name if name.startswith("_") else name
 
 
 MARKERS = ["o", "s", "^", "D", "v", "P", "X", "<", ">", "*", "h", "p"]
@@ -218,7 +238,7 @@ def draw_series(ax, rows, xcol, ycol, styles, axis_keys, legend):
     for name, pts in groups.items():
         marker, colour = styles(name)
         ax.plot([p[0] for p in pts], [p[1] for p in pts], linestyle="none", marker=marker,
-                color=colour, markersize=5, label=name if name not in legend else None)
+                color=colour, markersize=5, label=legend_label(name) if name not in legend else None)
         legend.add(name)
         for key in axis_keys:
             lines = OrderedDict()
@@ -256,8 +276,10 @@ def figure_legend(fig, axes_list, nrows_height):
                 names.append(n)
     if names:
         ncol = min(3, len(names))
-        fig.legend(handles, names, loc="upper center", ncol=ncol, fontsize=8, frameon=False,
-                   bbox_to_anchor=(0.5, 0.0))
+        leg = fig.legend(handles, names, loc="upper center", ncol=ncol, fontsize=8, frameon=False,
+                         bbox_to_anchor=(0.5, 0.0))
+        for t in leg.get_texts():
+            plain(t)
 
 
 def panels(plt, n, width=5.0, height=3.7, cols=3):
@@ -287,9 +309,9 @@ def plot_against(plt, rows, metric, xcol, xlabel, stem, title, out_dir, formats,
         if log_x:
             ax.set_xscale("log")
         ax.set_yscale("log")
-        ax.set_xlabel(xlabel)
-        ax.set_ylabel(metric)
-        ax.set_title(brdf, fontsize=10)
+        plain(ax.set_xlabel(xlabel))
+        plain(ax.set_ylabel(metric))
+        plain(ax.set_title(brdf, fontsize=10))
         ax.grid(True, which="major", alpha=0.3)
         ax.autoscale_view()
         if log_x:
@@ -298,7 +320,7 @@ def plot_against(plt, rows, metric, xcol, xlabel, stem, title, out_dir, formats,
             from matplotlib.ticker import MaxNLocator
             ax.xaxis.set_major_locator(MaxNLocator(integer=True, nbins=8))
         finish_log_axis(ax, "y")
-    fig.suptitle(title)
+    plain(fig.suptitle(title))
     fig.tight_layout()
     figure_legend(fig, axes, len(axes))
     out = save(fig, out_dir, stem, formats)
@@ -325,14 +347,14 @@ def plot_by_brdf(plt, all_rows, metric, out_dir, formats, axis_keys):
             draw_pareto(ax, pts, legend)
             ax.set_xscale("log")
             ax.set_yscale("log")
-            ax.set_xlabel(xlabel)
-            ax.set_ylabel(metric)
-            ax.set_title(brdf, fontsize=10)
+            plain(ax.set_xlabel(xlabel))
+            plain(ax.set_ylabel(metric))
+            plain(ax.set_title(brdf, fontsize=10))
             ax.grid(True, which="major", alpha=0.3)
             ax.autoscale_view()
             finish_log_axis(ax, "x")
             finish_log_axis(ax, "y")
-    fig.suptitle(metric + " against storage and time, per BRDF (log axes; lines only along a sweep)")
+    plain(fig.suptitle(metric + " against storage and time, per BRDF (log axes; lines only along a sweep)"))
     fig.tight_layout()
     figure_legend(fig, flat, len(brdfs))
     out = save(fig, out_dir, "by_brdf_" + metric, formats)
@@ -369,14 +391,14 @@ def plot_terms(plt, rows, metric, out_dir, formats, axis_keys):
             xs = sorted(pts)
             marker, colour = styles(name)
             ax.plot(xs, [pts[x] for x in xs], marker=marker, color=colour, markersize=5,
-                    linewidth=0.8, label=name if name not in legend else None)
+                    linewidth=0.8, label=legend_label(name) if name not in legend else None)
             legend.add(name)
             any_curve = True
-        ax.set_title(brdf, fontsize=10)
+        plain(ax.set_title(brdf, fontsize=10))
         ax.set_xlabel("textures (terms)")
         from matplotlib.ticker import MaxNLocator
         ax.xaxis.set_major_locator(MaxNLocator(integer=True))
-        ax.set_ylabel(metric)
+        plain(ax.set_ylabel(metric))
         ax.set_yscale("log")
         ax.grid(True, alpha=0.3)
         ax.autoscale_view()
@@ -384,7 +406,7 @@ def plot_terms(plt, rows, metric, out_dir, formats, axis_keys):
     del keys
     out = []
     if any_curve:
-        fig.suptitle(metric + " against number of textures (a curve per run: error after each term)")
+        plain(fig.suptitle(metric + " against number of textures (a curve per run: error after each term)"))
         fig.tight_layout()
         figure_legend(fig, axes, len(axes))
         out = save(fig, out_dir, "error_vs_terms", formats)

@@ -5,7 +5,9 @@
 Usage: experiments/plot_time_error.py BENCH.jsonl OUT.png [--cpu]
 x = wall seconds (or process CPU seconds with --cpu, when the lines have it),
 y = rel_mse after the last texture; a table of the same points is printed.
-Lines that are not JSON (e.g. "# command" comments) are skipped.
+Lines that are not JSON (e.g. "# command" comments) are skipped. Settings
+are text from the file: the table escapes them for markdown, the plot draws
+them as plain text (no mathtext or TeX).
 """
 import json
 import sys
@@ -20,6 +22,28 @@ def label(j):
     if j.get("texture", 16) != j.get("search_texture", j.get("texture", 16)):
         s += f" tex{j['texture']}"
     return s
+
+
+def md_cell(s):
+    """Markdown table cell text: one line, no cell split, no markup or HTML."""
+    s = " ".join(str(s).splitlines())
+    out = []
+    for c in s:
+        if c in "\\`*_[]#|~$":
+            out.append("\\" + c)
+        else:
+            out.append({"&": "&amp;", "<": "&lt;", ">": "&gt;"}.get(c, c))
+    return "".join(out)
+
+
+def plain(text):
+    """Draws a matplotlib Text as the characters it holds (no mathtext, no TeX)."""
+    text.set_usetex(False)
+    if hasattr(text, "set_parse_math"):  # matplotlib >= 3.5
+        text.set_parse_math(False)
+    else:
+        text.set_text(text.get_text().replace("$", r"\$"))
+    return text
 
 
 def main(argv):
@@ -47,19 +71,20 @@ def main(argv):
     print("| setting | textures | fits | %s | rel_mse |" % ("cpu s" if use_cpu else "wall s"))
     print("|---|---|---|---|---|")
     for p in pts:
-        print(f"| {p[0]} | {p[4]} | {p[3]} | {p[1]:.1f} | {p[2]:.4f} |")
+        print(f"| {md_cell(p[0])} | {p[4]} | {p[3]} | {p[1]:.1f} | {p[2]:.4f} |")
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     fig, ax = plt.subplots(figsize=(7, 4.5))
     markers = "osD^v<>ph*X"
     for i, p in enumerate(pts):
-        ax.scatter(p[1], p[2], marker=markers[i % len(markers)], s=50, label=f"{p[0]} ({p[4]} tex)")
+        ax.scatter(p[1], p[2], marker=markers[i % len(markers)], s=50, label=(" " if p[0].startswith("_") else "") + f"{p[0]} ({p[4]} tex)")
     ax.set_xlabel("process CPU seconds" if use_cpu else "wall seconds")
     ax.set_ylabel("rel_mse after the last texture")
     ax.set_title("projection search: error against time")
     ax.grid(True, alpha=0.3)
-    ax.legend(fontsize=7)
+    for t in ax.legend(fontsize=7).get_texts():
+        plain(t)
     fig.tight_layout()
     fig.savefig(argv[2], dpi=120)
     print(f"wrote {argv[2]}")

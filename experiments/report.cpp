@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "experiments/cli_util.h"
+#include "experiments/escape.h"
 #include "experiments/viewer.h"
 
 namespace bf {
@@ -17,33 +18,10 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string esc(const std::string& s) {
-  std::string o;
-  for (char c : s) {
-    switch (c) {
-      case '&': o += "&amp;"; break;
-      case '<': o += "&lt;"; break;
-      case '>': o += "&gt;"; break;
-      case '"': o += "&quot;"; break;
-      default: o += c;
-    }
-  }
-  return o;
-}
-
-// Relative URL of a folder-relative path (each segment percent-encoded as needed).
-std::string url(const std::string& rel) {
-  std::string o;
-  for (unsigned char c : rel) {
-    if (std::isalnum(c) || c == '/' || c == '.' || c == '_' || c == '-') o += static_cast<char>(c);
-    else {
-      char buf[4];
-      std::snprintf(buf, sizeof buf, "%%%02X", c);
-      o += buf;
-    }
-  }
-  return o;
-}
+// Every string of user origin on the page goes through one of these
+// (escape.h): HTML text and attribute values, relative URLs.
+std::string esc(const std::string& s) { return html_text(s); }
+std::string url(const std::string& rel) { return url_path(rel); }
 
 const char* kStyle = R"(
 body{font-family:system-ui,-apple-system,Segoe UI,Helvetica,Arial,sans-serif;margin:2em;color:#222;max-width:1400px}
@@ -183,7 +161,7 @@ void write_report_html(const ExperimentOutput& e, const OutputFiles& f, const st
   h << ". Config <code>" << esc(e.config_path) << "</code>";
   for (const auto& d : e.defines) h << " <code>-D " << esc(d) << "</code>";
   h << ".</p>\n<p class=\"files\">";
-  for (const char* file : {"results.csv", "results.md", "manifest.json", "config.toml"})
+  for (const char* file : {"results.csv", "results.md", "manifest.json", "config.toml", "plots.log"})
     if (exists_in(dir, file)) h << "<a href=\"" << url(file) << "\">" << file << "</a>";
   h << "</p>\n";
 

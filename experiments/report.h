@@ -1,8 +1,10 @@
-// report.html: one self-contained page (inline style, no scripts, no network)
-// with the results table, the plots, each run's sphere picture and factor
-// previews, and a link to every file of the experiment folder. Images and
-// links are relative paths inside the folder, so the folder can be moved or
-// archived as a whole.
+// report.html: one page (inline style, no network) with the results table,
+// the plots, the WebGL2 viewer (its inline script loads runs/<id>/viewer.js,
+// viewer.h), each run's sphere picture and factor previews, and a link to
+// every file of the experiment folder. Images, links and the viewer's data
+// are relative paths inside the folder, so the folder can be moved or
+// archived as a whole. Text of user origin is escaped for its context
+// (escape.h): HTML text, or JSON inside the script.
 #pragma once
 
 #include <set>

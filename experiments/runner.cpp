@@ -4,6 +4,7 @@
 #include "brdfs/safe_path.h"
 #include "experiments/interrupt.h"
 #include "experiments/outdir_lock.h"
+#include "experiments/plot_step.h"
 
 #include <algorithm>
 #include <cstdio>
@@ -647,6 +648,7 @@ RunSummary run_experiment(const RunOptions& opt, std::ostream& out, std::ostream
   }
   print_output_paths(out, sum.files);
   if (sum.failed) throw_failed_runs(sum, o.runs);
+  if (const std::string p = plot_failure(sum.files); !p.empty()) throw std::runtime_error(p);  // tables written
   return sum;
 }
 

@@ -10,6 +10,7 @@
 #include <stdexcept>
 
 #include "experiments/cli_util.h"
+#include "experiments/escape.h"
 #include "experiments/viewer_js.h"
 #include "factor/baseline_export.h"
 #include "factor/glsl.h"
@@ -174,8 +175,8 @@ void write_viewer_data(const Factorization& approx, const Brdf& original, const 
   j["scene"] = {{"light", {scene.light.x(), scene.light.y(), scene.light.z()}},
                 {"intensity", scene.intensity},
                 {"size", scene.size}};
-  const std::string text = "(window.BF_VIEWER = window.BF_VIEWER || {})[" + nlohmann::json(run_id).dump() +
-                           "] = " + j.dump() + ";\n";
+  const std::string text = "(window.BF_VIEWER = window.BF_VIEWER || {})[" + script_json(run_id) +
+                           "] = " + script_json(j) + ";\n";
   write_file_atomic(path, [&](std::ostream& o) { o << text; });
 }
 
@@ -211,20 +212,10 @@ std::string viewer_section(const std::vector<ViewerRun>& runs) {
     << "<script type=\"x-shader/x-fragment\" id=\"v-shader-main\">" << kViewerShaderMain << "</script>\n";
   nlohmann::json list = nlohmann::json::array();
   for (const auto& r : runs) {
-    std::string u;
-    for (unsigned char c : r.path) {
-      if (std::isalnum(c) || c == '/' || c == '.' || c == '_' || c == '-') {
-        u += char(c);
-      } else {
-        char buf[4];
-        std::snprintf(buf, sizeof buf, "%%%02X", c);
-        u += buf;
-      }
-    }
-    list.push_back({{"id", r.id}, {"path", u}, {"label", r.label}});
+    list.push_back({{"id", r.id}, {"path", url_path(r.path)}, {"label", r.label}});
   }
-  std::string text = list.dump();
-  for (size_t p = 0; (p = text.find("</", p)) != std::string::npos; p += 3) text.replace(p, 2, "<\\/");
+  // Inside a <script> element: no "</script", "<!--" or "<script" (escape.h).
+  const std::string text = script_json(list);
   // Test mode writes every viewer.js in while the page is parsed (so the
   // numbers exist when the page has loaded); otherwise each is loaded when its
   // run is shown. (The attribute is spelled in pieces: this is page text.)

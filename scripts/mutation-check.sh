@@ -19,6 +19,11 @@ mutations=(
   'texel-off-by-one|factor/projection.cpp|s/const double x = std::clamp\(s\.x\(\), 0\.0, double\(res - 1\)\);/const double x = std::clamp(s.x() + 1.0, 0.0, double(res - 1));/'
   'exr-transpose|factor/export.cpp|s/for \(int c = 0; c < 3; \+\+c\) px\[3 \* k \+ c\] = t\.texels\[c\]\[k\];/for (int c = 0; c < 3; ++c) px[3 * ((k % R) * R + k \/ R) + c] = t.texels[c][k];/; s/const float v = px\[3 \* k \+ c\];/const float v = px[3 * ((k % R) * R + k \/ R) + c];/'
   'reciprocity-conjugate-dropped|factor/homomorphic.cpp|s/for \(int c = 0; c < 3; \+\+c\) s\[c\] \+= t\.lookup\(c, sc\);/(void)sc;/'
+  'html-lt-not-escaped|experiments/escape.cpp|s/case \x27<\x27: o \+= "&lt;"; break;//'
+  'html-amp-not-escaped|experiments/escape.cpp|s/case \x27&\x27: o \+= "&amp;"; break;//'
+  'html-quot-not-escaped|experiments/escape.cpp|s/case \x27"\x27: o \+= "&quot;"; break;//'
+  'markdown-newline-kept|experiments/escape.cpp|s/if \(is_line_break\(c\)\) o \+= \x27 \x27;/if (is_line_break(c)) o += char(c);/'
+  'script-json-lt-kept|experiments/escape.cpp|s/if \(c == \x27<\x27\) o \+= "\\\\u003c";/if (false) o += "\\\\u003c";/'
 )
 
 want=("$@")
