@@ -38,21 +38,21 @@ class TableBrdf : public Brdf {
 TEST_CASE("metrics: unequal sample weights give the weighted closed form of every weighted metric") {
   // Three valid samples and a masked one:
   //   k  cos_i  weight  f          approximation   error f^ - f
-  //   0  0.6    1       (1, 1, 1)  (2, 1, 1)       (1, 0, 0)
+  //   0  0.6    1       (1, 1, 1)  (0.5, 1, 1)     (-0.5, 0, 0)
   //   1  0.8    3       (1, 1, 1)  (1, 1, 4)       (0, 0, 3)
   //   2  1.0    0       (1, 1, 1)  (1, 9, 1)       (0, 8, 0)   weight 0: only the max metrics see it
   //   3  below the horizon (masked), weight 5, approximation 100: never scored
   // W = 3 (1 + 3 + 0) = 12.
-  //   lin_rmse = sqrt((1 * 1^2 + 3 * 3^2) / 12) = sqrt(28 / 12)
-  //   lin_mae  = (1 * 1 + 3 * 3) / 12 = 10 / 12
+  //   lin_rmse = sqrt((1 * 0.5^2 + 3 * 3^2) / 12) = sqrt(27.25 / 12)
+  //   lin_mae  = (1 * 0.5 + 3 * 3) / 12 = 9.5 / 12   (|error|: signed it would be 8.5 / 12)
   //   lin_max  = 8
-  //   cos_rmse = sqrt((1 * (1 * 0.6)^2 + 3 * (3 * 0.8)^2) / 12) = sqrt(17.64 / 12)
+  //   cos_rmse = sqrt((1 * (0.5 * 0.6)^2 + 3 * (3 * 0.8)^2) / 12) = sqrt(17.37 / 12)
   // A = (1, 1, 1) (the mean of the valid samples), so with e = eps
-  //   rel_mse = (1 * ln((2 + e)/(1 + e))^2 + 3 * ln((4 + e)/(1 + e))^2) / 12
-  //   rel_mae = (1 * ln((2 + e)/(1 + e))   + 3 * ln((4 + e)/(1 + e)))   / 12
+  //   rel_mse = (1 * ln((0.5 + e)/(1 + e))^2 + 3 * ln((4 + e)/(1 + e))^2) / 12
+  //   rel_mae = (1 * |ln((0.5 + e)/(1 + e))| + 3 * ln((4 + e)/(1 + e))) / 12
   //   rel_max = ln((9 + e)/(1 + e)).
   // With every weight ignored (taken as 1) the same data give lin_rmse
-  // sqrt(74 / 9), lin_mae 12 / 9, cos_rmse sqrt(69.6 / 9): all different.
+  // sqrt(73.25 / 9), lin_mae 11.5 / 9, cos_rmse sqrt(69.85 / 9): all different.
   const Vec3 wi0(0.8, 0.0, 0.6), wi1(0.0, 0.6, 0.8), wi2(0.0, 0.0, 1.0), wi3(0.6, 0.0, -0.8);
   const Vec3 wo0(0.0, 0.0, 1.0), wo1(0.6, 0.0, 0.8), wo2(0.0, 0.8, 0.6), wo3(0.0, 0.0, 1.0);
   SampleSet s;
@@ -64,7 +64,7 @@ TEST_CASE("metrics: unequal sample weights give the weighted closed form of ever
   REQUIRE(s.valid_count() == 3);
   REQUIRE(s.invalid_horizon == 1);
   TableBrdf approx;
-  approx.add(wi0, wo0, Rgb(2, 1, 1));
+  approx.add(wi0, wo0, Rgb(0.5, 1, 1));
   approx.add(wi1, wo1, Rgb(1, 1, 4));
   approx.add(wi2, wo2, Rgb(1, 9, 1));
   approx.add(wi3, wo3, Rgb(100, 100, 100));
@@ -73,13 +73,13 @@ TEST_CASE("metrics: unequal sample weights give the weighted closed form of ever
   for (int c = 0; c < 3; ++c) CHECK(t.A[c] == 1.0);
   const Metrics m = evaluate_metrics(approx, s, t);
   CHECK(m.samples == 3);
-  CHECK(m.lin_rmse == Approx(std::sqrt(28.0 / 12.0)).epsilon(1e-14));
-  CHECK(m.lin_mae == Approx(10.0 / 12.0).epsilon(1e-14));
+  CHECK(m.lin_rmse == Approx(std::sqrt(27.25 / 12.0)).epsilon(1e-14));
+  CHECK(m.lin_mae == Approx(9.5 / 12.0).epsilon(1e-14));
   CHECK(m.lin_max == 8.0);
-  CHECK(m.cos_rmse == Approx(std::sqrt(17.64 / 12.0)).epsilon(1e-14));
-  const double g2 = std::log((2 + e) / (1 + e)), g4 = std::log((4 + e) / (1 + e)), g9 = std::log((9 + e) / (1 + e));
-  CHECK(m.rel_mse == Approx((g2 * g2 + 3 * g4 * g4) / 12.0).epsilon(1e-13));
-  CHECK(m.rel_mae == Approx((g2 + 3 * g4) / 12.0).epsilon(1e-13));
+  CHECK(m.cos_rmse == Approx(std::sqrt(17.37 / 12.0)).epsilon(1e-14));
+  const double gh = std::log((0.5 + e) / (1 + e)), g4 = std::log((4 + e) / (1 + e)), g9 = std::log((9 + e) / (1 + e));
+  CHECK(m.rel_mse == Approx((gh * gh + 3 * g4 * g4) / 12.0).epsilon(1e-13));
+  CHECK(m.rel_mae == Approx((-gh + 3 * g4) / 12.0).epsilon(1e-13));
   CHECK(m.rel_max == Approx(g9).epsilon(1e-13));
 
   // Scaling every weight by the same factor changes nothing (W scales too).
