@@ -77,3 +77,48 @@ TEST_CASE("svd: rim texels are tabulated at radius 1 - 1/(R-1), interior texels 
   CHECK(t.M[0](centre, centre) == Approx(1.0).epsilon(1e-15));
   CHECK(t.M[1](east_half, east_half) == Approx(0.6).epsilon(1e-14));
 }
+
+TEST_CASE("svd: log mode's A is the mean over texel pairs inside the closed disk, rim texels included") {
+  // R = 5: the 13 texel points with |p| <= 1 are (0, 0) (z = 1), four at
+  // radius 0.5 (z = 0.75 / 1.25 = 0.6), four at radius sqrt(0.5)
+  // (z = 0.5 / 1.5 = 1/3) and four on the edge (radius 1, evaluated at 0.75:
+  // z = 0.28). Channel 0 is wi.z, so A_0 = (1 + 4 * 0.6 + 4/3 + 4 * 0.28) / 13
+  // (the mean over the 13 x 13 inside pairs); leaving out the edge texels
+  // would give (1 + 2.4 + 4/3) / 9.
+  SvdOptions opt;
+  opt.res = 5;
+  opt.rank = 1;
+  opt.log = true;
+  const SvdTable t = tabulate_svd(Where(), opt);
+  CHECK(t.A[0] == Approx((1.0 + 4 * 0.6 + 4.0 / 3.0 + 4 * 0.28) / 13.0).epsilon(1e-13));
+  CHECK(t.A[1] == Approx((1.0 + 4 * 0.6 + 4.0 / 3.0 + 4 * 0.28) / 13.0).epsilon(1e-13));
+}
+
+TEST_CASE("svd: halfdiff pairs below the horizon are read at the pulled-in rim's elevation") {
+  // R = 5: the rim is pulled in to radius 0.75, elevation z = 0.28 (above).
+  // A (h, d) pair whose wi falls below the horizon is lifted to that
+  // elevation, so channel 0 (wi.z) holds 0.28 there; likewise wo and channel 1.
+  SvdOptions opt;
+  opt.res = 5;
+  opt.rank = 1;
+  opt.param = Parameterization::HalfDiff;
+  const SvdTable t = tabulate_svd(Where(), opt);
+  const DiskGrid& g = t.grid;
+  const double inset = 0.25;
+  int below_i = 0, below_o = 0;
+  for (size_t r = 0; r < g.count(); ++r)
+    for (size_t c = 0; c < g.count(); ++c) {
+      Vec3 wi, wo;
+      half_diff_inverse(g.direction(g.texels[r], inset), g.direction(g.texels[c], inset), wi, wo);
+      if (wi.z() <= 0.0) {
+        ++below_i;
+        CHECK(t.M[0](r, c) == Approx(0.28).epsilon(1e-12));
+      }
+      if (wo.z() <= 0.0) {
+        ++below_o;
+        CHECK(t.M[1](r, c) == Approx(0.28).epsilon(1e-12));
+      }
+    }
+  CHECK(below_i > 10);
+  CHECK(below_o > 10);
+}
