@@ -93,7 +93,11 @@ if [ "${1:-}" = "--sample" ]; then
       echo "   caught (exit $rc): $(grep -E '^test cases:' "$log_dir/$name.test.log" | tail -1)"
     fi
   done
-  cmake --build build -j "$(nproc)" > "$log_dir/restore.build.log" 2>&1
+  # Rebuild the executables used, so ./build matches the sources again.
+  targets=$(for m in "${sample[@]}"; do IFS='|' read -r name _ _ target _ <<< "$m"
+    if [ ${#want[@]} -eq 0 ] || [[ " ${want[*]} " == *" $name "* ]]; then echo "$target"; fi; done | sort -u)
+  # shellcheck disable=SC2086
+  cmake --build build -j "$(nproc)" --target $targets > "$log_dir/restore.build.log" 2>&1
   exit $survived
 fi
 
