@@ -105,7 +105,7 @@ TEST_CASE("readers: ASTM and pbrt .brdf theta within 1e-6 beyond pi/2 is read, t
   }
 }
 
-TEST_CASE("readers: a sample-list CSV masks and counts theta in (pi/2, pi], rejects theta beyond pi") {
+TEST_CASE("readers: a sample-list CSV masks and counts theta between pi/2 and pi, rejects theta beyond pi") {
   TempDir d("angles_csv");
   {
     std::ofstream f(d.file("m.csv"));
