@@ -39,8 +39,11 @@ void check_angles(const std::string& at, const std::array<double, 4>& a) {
     const double v = a[c];
     if (theta) {
       if (!(v >= 0.0 && v <= M_PI / 2 + kTol)) {
-        std::string hint =
-            (v > M_PI / 2 && v <= 90.0 + kTol) ? " (degrees? the format stores radians)" : "";
+        // In (pi/2, pi] a direction below the surface (or a small angle in
+        // degrees); beyond pi up to 90 most likely degrees.
+        std::string hint = (v > M_PI / 2 && v <= M_PI) ? " (below the horizon, or degrees? the format stores radians)"
+                           : (v > M_PI && v <= 90.0 + kTol) ? " (degrees? the format stores radians)"
+                                                            : "";
         throw std::invalid_argument(at + ": " + kAngleNames[c] +
                                     " expected radians in [0, pi/2], found " + fmt(v) + hint);
       }
