@@ -43,7 +43,7 @@ if ! cmp -s "$tmp/catch.sorted" "$tmp/ctest.sorted"; then
   echo "check-test-count: FAILED: $n_catch Catch test cases (not [slow], not hidden), $n_ctest CTest tests (ctest -N -LE 'slow|python|docs')" >&2
   echo "  '<' only in Catch's list (never run by CTest), '>' only in CTest's (matches no Catch test):" >&2
   diff "$tmp/catch.sorted" "$tmp/ctest.sorted" | grep '^[<>]' | head -40 | sed 's/^/  /' >&2 || true
-  echo "  A TEST_CASE name must not contain ';' (catch_discover_tests splits it there)." >&2
+  echo "  A TEST_CASE name must not contain ';' (catch_discover_tests splits it there) or '[' / ']' (it merges later tests into one entry)." >&2
   exit 1
 fi
 if [ "$n_catch" -eq 0 ]; then
