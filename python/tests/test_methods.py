@@ -176,8 +176,6 @@ def test_export_reload_is_bit_identical(tmp_path, grid8):
     merl = str(tmp_path / "paint.binary")
     f.export_merl(merl)
     assert os.path.getsize(merl) == 34992012
-    with pytest.raises(ValueError, match=r"^export: method svd has no texture export"):
-        bf.svd(bf.brdf("lambert"), terms=1, texture_size=8).export(str(tmp_path))
 
 
 def test_factor_dispatches_by_kind(grid8, bluepaint):
