@@ -193,7 +193,7 @@ def test_config_naming_a_fifo_sample_file_is_refused(tmp_path):
         [experiment]
         name = "fifo"
         [[brdf]]
-        spec = "lambert"
+        model = "lambert"
         [[sampling]]
         kind = "file"
         path = "%s"
