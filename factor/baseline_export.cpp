@@ -476,9 +476,19 @@ class DataFile {
   static constexpr long long kMaxValues = static_cast<long long>(kMaxDataFileBytes / 8);
 
   DataFile(const Reader& r, const json& data, std::string path)
-      : r_(r), data_(data), path_(std::move(path)), declared_(size_t(r.integer(data, "values", 0, kMaxValues))) {
+      : r_(r), data_(data), path_(std::move(path)), declared_(declared_values(r, data)) {
     const json& blocks = r_.member(data_, "blocks", "an array of blocks");
     if (!blocks.is_array()) r_.fail("data.blocks", "an array of blocks", Reader::show(blocks));
+  }
+
+  // data.values, at most kMaxValues (the data-file cap).
+  static size_t declared_values(const Reader& r, const json& data) {
+    const std::string e = "an integer in 0.." + std::to_string(kMaxValues) + " (a data file of at most " +
+                          std::to_string(kMaxDataFileBytes) + " bytes)";
+    const json& v = r.member(data, "values", e);
+    if (!v.is_number_integer() || v.get<long long>() < 0 || v.get<long long>() > kMaxValues)
+      r.fail("data.values", e, Reader::show(v));
+    return size_t(v.get<long long>());
   }
 
   // Block `name` holds `count` values (from the sidecar's sizes): its count

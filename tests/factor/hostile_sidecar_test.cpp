@@ -146,8 +146,9 @@ TEST_CASE("hostile sidecars: data.values is bounded by the data-file cap and by 
     json j = j0;
     j["data"]["values"] = 1LL << 31;
     write_json(files.sidecar, j);
-    const std::string msg = "field 'values': expected an integer in 0.." + std::to_string(kMaxDataFileBytes / 8) +
-                            ", found 2147483648";
+    const std::string msg = "field 'data.values': expected an integer in 0.." +
+                            std::to_string(kMaxDataFileBytes / 8) + " (a data file of at most " +
+                            std::to_string(kMaxDataFileBytes) + " bytes), found 2147483648";
     CHECK_THROWS_WITH(load_baseline_export(files.sidecar), Contains(files.sidecar) && Contains(msg));
     std::string out;
     CHECK(cli_eval(d, files.sidecar, &out) == 2);
