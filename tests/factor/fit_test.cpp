@@ -422,7 +422,7 @@ TEST_CASE("fit: the exposed normal matrix is symmetric and sums to the sample we
   CHECK(m2 == m);
 }
 
-TEST_CASE("fit options: huge weights are refused naming the key, the bound still fits") {
+TEST_CASE("fit options: huge weights are refused naming the key and the bound still fits") {
   {
     FitOptions o;
     o.smoothing = 1e300;
