@@ -11,9 +11,11 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <stdexcept>
 
+#include "brdfs/file_check.h"
 #include "factor/atomic_batch.h"
 #include "factor/export.h"  // kFactorExportFormat, kFactorExportFormatVersion
 #include "factor/glsl_target.h"
@@ -449,29 +451,6 @@ class Reader {
     }
     return r;
   }
-  // Block `name` of the data file, checked to hold `count` values.
-  std::vector<double> block(const json& data, const std::vector<double>& values, const std::string& name,
-                            size_t count) const {
-    const json& blocks = member(data, "blocks", "an array of blocks");
-    if (!blocks.is_array()) fail("data.blocks", "an array of blocks", show(blocks));
-    for (size_t b = 0; b < blocks.size(); ++b) {
-      const json& bj = blocks[b];
-      if (!bj.is_object() || !bj.contains("name") || bj["name"] != name) continue;
-      const std::string where = "data.blocks[" + std::to_string(b) + "]";
-      const json& off = member(bj, "offset", "an integer");
-      const json& cnt = member(bj, "count", "an integer");
-      if (!cnt.is_number_unsigned() || cnt.get<size_t>() != count)
-        fail(where + ".count", std::to_string(count) + " (from the sidecar's sizes)", show(cnt));
-      if (!off.is_number_unsigned() || off.get<size_t>() > values.size() ||
-          values.size() - off.get<size_t>() < count)
-        fail(where + ".offset", "an offset with " + std::to_string(count) + " values after it in the " +
-                                    std::to_string(values.size()) + "-value data file",
-             show(off));
-      const size_t o = off.get<size_t>();
-      return std::vector<double>(values.begin() + std::ptrdiff_t(o), values.begin() + std::ptrdiff_t(o + count));
-    }
-    fail("data.blocks", "a block named \"" + name + "\"", "none");
-  }
   // Zeros outside the disk grid's mask (a full R*R texture at `t`).
   void check_masked(const std::vector<double>& v, size_t at, const DiskGrid& grid, const std::string& what) const {
     for (size_t t = 0; t < size_t(grid.res) * grid.res; ++t)
@@ -485,25 +464,93 @@ class Reader {
   std::string file_;
 };
 
-std::vector<double> read_f64(const std::string& path, const std::string& sidecar, size_t expected_count) {
-  std::error_code ec;
-  const auto size = fs::file_size(path, ec);
-  if (ec) throw std::invalid_argument(sidecar + ": field 'data.file': cannot read " + path + ": " + ec.message());
-  if (size != expected_count * 8)
-    throw std::invalid_argument(path + ": expected " + std::to_string(expected_count * 8) + " bytes (" +
-                                std::to_string(expected_count) + " float64 values, data.values of " + sidecar +
-                                "), found " + std::to_string(size));
-  std::vector<double> v(expected_count);
-  std::ifstream in(path, std::ios::binary);
-  in.read(reinterpret_cast<char*>(v.data()), std::streamsize(size));
-  if (!in) throw std::invalid_argument(path + ": read failed");
-  static_assert(sizeof(double) == 8, "float64");
-  for (size_t i = 0; i < v.size(); ++i)
-    if (!std::isfinite(v[i]))
-      throw std::invalid_argument(path + ": value " + std::to_string(i) + ": expected a finite number, found " +
-                                  std::to_string(v[i]));
-  return v;
-}
+// The sidecar's data file (data.file, data.values). Every count is checked
+// before anything is allocated or read: data.values against the data-file cap
+// (kMaxDataFileBytes, as every data reader), each block the method reads
+// (expect(), its count computed from the sidecar's sizes, which are bounded by
+// the documented option ranges) against data.values, their sum against
+// data.values, and data.values against the file's actual size. Then read()
+// reads the file once.
+class DataFile {
+ public:
+  static constexpr long long kMaxValues = static_cast<long long>(kMaxDataFileBytes / 8);
+
+  DataFile(const Reader& r, const json& data, std::string path)
+      : r_(r), data_(data), path_(std::move(path)), declared_(declared_values(r, data)) {
+    const json& blocks = r_.member(data_, "blocks", "an array of blocks");
+    if (!blocks.is_array()) r_.fail("data.blocks", "an array of blocks", Reader::show(blocks));
+  }
+
+  // data.values, at most kMaxValues (the data-file cap).
+  static size_t declared_values(const Reader& r, const json& data) {
+    const std::string e = "an integer in 0.." + std::to_string(kMaxValues) + " (a data file of at most " +
+                          std::to_string(kMaxDataFileBytes) + " bytes)";
+    const json& v = r.member(data, "values", e);
+    if (!v.is_number_integer() || v.get<long long>() < 0 || v.get<long long>() > kMaxValues)
+      r.fail("data.values", e, Reader::show(v));
+    return size_t(v.get<long long>());
+  }
+
+  // Block `name` holds `count` values (from the sidecar's sizes): its count
+  // and offset are checked against data.values.
+  void expect(const std::string& name, size_t count) {
+    const json& blocks = data_.at("blocks");
+    for (size_t b = 0; b < blocks.size(); ++b) {
+      const json& bj = blocks[b];
+      if (!bj.is_object() || !bj.contains("name") || bj["name"] != name) continue;
+      const std::string where = "data.blocks[" + std::to_string(b) + "]";
+      const json& off = r_.member(bj, "offset", "an integer");
+      const json& cnt = r_.member(bj, "count", "an integer");
+      if (!cnt.is_number_unsigned() || cnt.get<size_t>() != count)
+        r_.fail(where + ".count", std::to_string(count) + " (from the sidecar's sizes)", Reader::show(cnt));
+      if (!off.is_number_unsigned() || off.get<size_t>() > declared_ || declared_ - off.get<size_t>() < count)
+        r_.fail(where + ".offset",
+                "an offset with " + std::to_string(count) + " values after it in the " + std::to_string(declared_) +
+                    "-value data file (data.values)",
+                Reader::show(off));
+      offsets_[name] = {off.get<size_t>(), count};
+      expected_ += count;
+      return;
+    }
+    r_.fail("data.blocks", "a block named \"" + name + "\"", "none");
+  }
+
+  // Checks the sum of the blocks against data.values and data.values against
+  // the file (a regular file of exactly 8 x data.values bytes), then reads it;
+  // every value must be finite.
+  void read(const std::string& sizes) {
+    if (expected_ != declared_)
+      r_.fail("data.values", std::to_string(expected_) + " (the blocks of " + sizes + ")", std::to_string(declared_));
+    const uint64_t size = check_regular_file(path_, kMaxDataFileBytes, "data file");
+    if (size != uint64_t(declared_) * 8)
+      throw std::invalid_argument(path_ + ": expected " + std::to_string(uint64_t(declared_) * 8) + " bytes (" +
+                                  std::to_string(declared_) + " float64 values, data.values of " + r_.file() +
+                                  "), found " + std::to_string(size));
+    values_.resize(declared_);
+    std::ifstream in(path_, std::ios::binary);
+    in.read(reinterpret_cast<char*>(values_.data()), std::streamsize(size));
+    if (!in) throw std::invalid_argument(path_ + ": read failed");
+    static_assert(sizeof(double) == 8, "float64");
+    for (size_t i = 0; i < values_.size(); ++i)
+      if (!std::isfinite(values_[i]))
+        throw std::invalid_argument(path_ + ": value " + std::to_string(i) + ": expected a finite number, found " +
+                                    std::to_string(values_[i]));
+  }
+
+  // The values of a block named in expect(), after read().
+  std::vector<double> block(const std::string& name) const {
+    const auto& [o, n] = offsets_.at(name);
+    return std::vector<double>(values_.begin() + std::ptrdiff_t(o), values_.begin() + std::ptrdiff_t(o + n));
+  }
+
+ private:
+  const Reader& r_;
+  const json& data_;
+  std::string path_;
+  size_t declared_ = 0, expected_ = 0;
+  std::map<std::string, std::pair<size_t, size_t>> offsets_;
+  std::vector<double> values_;
+};
 
 }  // namespace
 
@@ -625,25 +672,24 @@ BaselineExportFiles write_baseline_export(const Factorization& f, const std::str
 }
 
 std::string sidecar_method(const std::string& json_path) {
-  std::ifstream in(json_path);
-  if (!in) return "";
-  const json j = json::parse(in, nullptr, false);
+  const json j = json::parse(read_regular_file(json_path, kMaxTextFileBytes, "factorization sidecar"), nullptr, false);
   if (!j.is_object() || !j.contains("method") || !j["method"].is_string()) return "";
   return j["method"].get<std::string>();
 }
 
 namespace {
 
-// The method-specific part of an export (after the common header and data
-// block were checked): the factorization the sidecar describes.
-std::shared_ptr<Factorization> load_svd(const Reader& r, const json& j, const json& data, const std::vector<double>& values, double seconds) {
+// The method-specific part of an export (after the common header was
+// checked): its sizes (bounded by the method's documented option ranges),
+// the blocks they imply (checked against the data file before it is read),
+// and the factorization the sidecar describes.
+std::shared_ptr<Factorization> load_svd(const Reader& r, const json& j, DataFile& df, double seconds) {
   SvdOptions o;
   const std::string param = r.string(j, "parameterization");
   if (param == "wiwo") o.param = Parameterization::WiWo;
   else if (param == "halfdiff") o.param = Parameterization::HalfDiff;
   else r.fail("parameterization", "\"wiwo\" or \"halfdiff\"", "\"" + param + "\"");
   o.res = int(r.integer(j, "resolution", 2, 256));
-  o.rank = int(r.integer(j, "rank", 1, 1 << 20));
   o.log = r.boolean(j, "log");
   o.rim_inset = r.number(j, "rim_inset", 1e-300, 0.5);
   if (o.param == Parameterization::HalfDiff) o.extend_below_horizon = r.boolean(j, "extend_below_horizon");
@@ -655,18 +701,23 @@ std::shared_ptr<Factorization> load_svd(const Reader& r, const json& j, const js
     o.subtract_eps = r.boolean(j, "subtract_eps");
   }
   DiskGrid grid = DiskGrid::make(o.res);
-  const size_t n = grid.count(), RR = size_t(o.res) * o.res, K = size_t(o.rank);
-  if (K > n) r.fail("rank", "at most " + std::to_string(n) + " (masked texels)", std::to_string(K));
-  const json& blocks = r.member(data, "blocks", "an array");
+  const size_t n = grid.count(), RR = size_t(o.res) * o.res;
+  o.rank = int(r.integer(j, "rank", 1, (long long)n));
+  const size_t K = size_t(o.rank);
   size_t S = 0;
-  for (const json& b : blocks)
+  for (const json& b : j.at("data").at("blocks"))
     if (b.is_object() && b.contains("name") && b["name"] == "sigma" && b.contains("count") &&
         b["count"].is_number_unsigned())
       S = b["count"].get<size_t>() / 3;
   if (S < K || S > n) r.fail("data.blocks sigma.count", "3 x (rank.." + std::to_string(n) + ")", std::to_string(3 * S));
-  const auto sigma = r.block(data, values, "sigma", 3 * S);
-  const auto u = r.block(data, values, "u", 3 * K * RR);
-  const auto v = r.block(data, values, "v", 3 * K * RR);
+  df.expect("sigma", 3 * S);
+  df.expect("u", 3 * K * RR);
+  df.expect("v", 3 * K * RR);
+  df.read("rank " + std::to_string(K) + ", resolution " + std::to_string(o.res) + " and " + std::to_string(S) +
+          " singular values per channel");
+  const auto sigma = df.block("sigma");
+  const auto u = df.block("u");
+  const auto v = df.block("v");
   std::array<TruncatedSvd, 3> svd;
   for (int c = 0; c < 3; ++c) {
     svd[c].sigma.resize(Eigen::Index(S));
@@ -686,31 +737,33 @@ std::shared_ptr<Factorization> load_svd(const Reader& r, const json& j, const js
   return std::make_shared<SvdFactorization>(o, std::move(grid), A, std::move(svd), seconds);
 }
 
-std::shared_ptr<Factorization> load_shk(const Reader& r, const json& j, const json& data, const std::vector<double>& values, double seconds) {
+std::shared_ptr<Factorization> load_shk(const Reader& r, const json& j, DataFile& df, double seconds) {
   ShkOptions o;
-  o.order = int(r.integer(j, "order", 0, 200));
-  o.view_res = int(r.integer(j, "view_resolution", 2, 512));
+  o.order = int(r.integer(j, "order", 0, ShkOptions::kMaxOrder));
+  o.view_res = int(r.integer(j, "view_resolution", 2, ShkOptions::kMaxTextureSize));
   o.reduced = r.boolean(j, "reduced");
   o.rim_inset = r.number(j, "rim_inset", 1e-300, 0.1);
   o.min_cos = r.number(j, "min_cos", 1e-300, 1.0);
   o.float_textures = r.boolean(j, "float_textures");
   const json& quad = r.member(j, "quadrature", "an object");
   if (quad.is_object()) {
-    o.theta_nodes = int(r.integer(quad, "theta_nodes", 1, 1 << 20));
-    o.phi_nodes = int(r.integer(quad, "phi_nodes", 1, 1 << 20));
+    o.theta_nodes = int(r.integer(quad, "theta_nodes", 1, ShkOptions::kMaxThetaNodes));
+    o.phi_nodes = int(r.integer(quad, "phi_nodes", 1, ShkOptions::kMaxPhiNodes));
   }
-  DiskGrid grid = DiskGrid::make(o.view_res);
   const size_t N = size_t(sh_count(o.order)), R = size_t(o.view_res), RR = R * R;
+  df.expect("coefficients", o.reduced ? 3 * N * R : 3 * N * RR);
+  df.read("order " + std::to_string(o.order) + " and view_resolution " + std::to_string(o.view_res) +
+          (o.reduced ? " (reduced)" : ""));
+  const auto v = df.block("coefficients");
+  DiskGrid grid = DiskGrid::make(o.view_res);
   std::array<Eigen::MatrixXd, 3> coeffs;
   if (o.reduced) {
-    const auto v = r.block(data, values, "coefficients", 3 * N * R);
     for (int c = 0; c < 3; ++c) {
       coeffs[c].resize(Eigen::Index(N), Eigen::Index(R));
       for (size_t i = 0; i < N; ++i)
         for (size_t jj = 0; jj < R; ++jj) coeffs[c](Eigen::Index(i), Eigen::Index(jj)) = v[(c * N + i) * R + jj];
     }
   } else {
-    const auto v = r.block(data, values, "coefficients", 3 * N * RR);
     for (int c = 0; c < 3; ++c) {
       coeffs[c].resize(Eigen::Index(N), Eigen::Index(grid.count()));
       for (size_t i = 0; i < N; ++i) {
@@ -727,15 +780,19 @@ std::shared_ptr<Factorization> load_shk(const Reader& r, const json& j, const js
   return f;
 }
 
-std::shared_ptr<Factorization> load_shr(const Reader& r, const json& j, const json& data, const std::vector<double>& values, double seconds) {
+std::shared_ptr<Factorization> load_shr(const Reader& r, const json& j, DataFile& df, double seconds) {
   ShrCoefficients all;
-  all.F = int(r.integer(j, "order", 0, 2000));
-  all.P = int(r.integer(j, "view_order", 0, 2000));
+  // The orders a fit can have (ShrOptions): the table below has (F+1)(P+1)^2
+  // entries per channel, at most 33 times the coefficients the data file holds.
+  all.F = int(r.integer(j, "order", 0, ShrOptions::kMaxOrder));
+  all.P = int(r.integer(j, "view_order", 0, ShrOptions::kMaxViewOrder));
   all.energy = r.rgb(j, "energy", false);
   const double min_cos = r.number(j, "min_cos", 1e-300, 1.0);
   const double energy_eps = j.contains("energy_eps") && j["energy_eps"].is_number() ? j["energy_eps"].get<double>() : 0.0;
   const size_t M = shr_coefficient_count(all.F, all.P);
-  const auto rho = r.block(data, values, "rho", 3 * M);
+  df.expect("rho", 3 * M);
+  df.read("order " + std::to_string(all.F) + " and view_order " + std::to_string(all.P));
+  const auto rho = df.block("rho");
   for (int c = 0; c < 3; ++c) {
     all.rho[c].assign(size_t(all.F + 1) * (all.P + 1) * (all.P + 1), 0.0);
     size_t n = c * M;
@@ -751,10 +808,9 @@ std::shared_ptr<Factorization> load_shr(const Reader& r, const json& j, const js
 std::shared_ptr<Factorization> load_baseline_export(const std::string& json_path) {
   json j;
   {
-    std::ifstream in(json_path, std::ios::binary);
-    if (!in) throw std::invalid_argument(json_path + ": cannot open factorization sidecar");
+    const std::string text = read_regular_file(json_path, kMaxTextFileBytes, "factorization sidecar");
     try {
-      j = json::parse(in);
+      j = json::parse(text);
     } catch (const json::exception& e) {
       throw std::invalid_argument(json_path + ": invalid JSON: " + e.what());
     }
@@ -771,17 +827,15 @@ std::shared_ptr<Factorization> load_baseline_export(const std::string& json_path
   if (r.string(data, "type") != "float64") r.fail("data.type", "\"float64\"", Reader::show(data["type"]));
   if (r.string(data, "byte_order") != "little-endian")
     r.fail("data.byte_order", "\"little-endian\"", Reader::show(data["byte_order"]));
-  const long long nvalues = r.integer(data, "values", 0, 1LL << 31);
   const std::string file = r.string(data, "file");
-  if (file.empty() || file.find('/') != std::string::npos)
+  if (file.empty() || file.find('/') != std::string::npos || file == "." || file == "..")
     r.fail("data.file", "a file name in the sidecar's folder", "\"" + file + "\"");
-  const std::string data_path = (fs::path(json_path).parent_path() / file).string();
-  const std::vector<double> values = read_f64(data_path, json_path, size_t(nvalues));
+  DataFile df(r, data, (fs::path(json_path).parent_path() / file).string());
   const double seconds = j.contains("seconds") ? r.number(j, "seconds", 0.0, 1e12) : 0.0;
 
-  if (method == "svd") return load_svd(r, j, data, values, seconds);
-  if (method == "sh-k") return load_shk(r, j, data, values, seconds);
-  return load_shr(r, j, data, values, seconds);
+  if (method == "svd") return load_svd(r, j, df, seconds);
+  if (method == "sh-k") return load_shk(r, j, df, seconds);
+  return load_shr(r, j, df, seconds);
 }
 
 }  // namespace bf

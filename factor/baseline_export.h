@@ -57,12 +57,19 @@ std::vector<std::pair<std::string, FloatImage>> baseline_textures(const Factoriz
 // Reads an export back from its sidecar (the .f64 file relative to the
 // sidecar's folder). Validates format, version, method, every field read, the
 // data file's size against its blocks, finite values, and zeros outside the
-// disk grid's mask. Errors name the file, the field, what was expected and
-// what was found.
+// disk grid's mask. Every count is bounded before anything is allocated or
+// read: sizes by the method's option ranges (svd resolution 2..256 and rank
+// at most the masked texels; sh-k ShkOptions::kMax*; sh-r order
+// 0..ShrOptions::kMaxOrder, view_order 0..kMaxViewOrder), data.values by the
+// data-file cap (kMaxDataFileBytes / 8), each block by data.values, their sum
+// equal to data.values, and data.values by the data file's size. The sidecar
+// and the data file must be regular files (brdfs/file_check.h). Errors name
+// the file, the field, what was expected and what was found.
 std::shared_ptr<Factorization> load_baseline_export(const std::string& json_path);
 
 // The "method" of a factorization sidecar ("" when the file is not a JSON
-// object with a string method): lets the .json loader dispatch.
+// object with a string method). Throws std::invalid_argument naming the path
+// when it is not a regular file of at most kMaxTextFileBytes.
 std::string sidecar_method(const std::string& json_path);
 
 }  // namespace bf

@@ -25,6 +25,7 @@
 #include "factor/glsl.h"
 #include "factor/image_io.h"
 #include "factor/model_fit.h"
+#include "factor/model_glsl.h"
 
 namespace bf {
 
@@ -487,24 +488,68 @@ std::shared_ptr<HomomorphicFactorization> load_factorization(const std::string& 
                                                     log_range);
 }
 
-namespace {
-bool is_model_fit_file(const std::string& path) {
-  check_regular_file(path, kMaxTextFileBytes, "");
-  std::ifstream in(path);
-  if (!in) return false;
-  const nlohmann::json j = nlohmann::json::parse(in, nullptr, false);
-  return j.is_object() && j.contains("format") && j["format"] == kModelFitFormat;
+ExportedFiles write_export(const Factorization& f, const std::string& dir, const std::string& stem,
+                           const std::string& origin) {
+  if (const auto* h = dynamic_cast<const HomomorphicFactorization*>(&f)) return write_factorization(*h, dir, stem);
+  if (is_baseline_method(f.method())) {
+    const BaselineExportFiles b = write_baseline_export(f, dir, stem);
+    ExportedFiles e;
+    e.sidecar = b.sidecar;
+    e.glsl = b.glsl;
+    e.textures = b.textures;
+    e.data = b.data;
+    return e;
+  }
+  if (const auto* mf = dynamic_cast<const ModelFitFactorization*>(&f)) {
+    if (stem.empty() || stem.find('/') != std::string::npos)
+      throw std::invalid_argument("export: stem must be a non-empty file name without '/', found \"" + stem + "\"");
+    std::error_code ec;
+    fs::create_directories(dir, ec);
+    if (ec) throw std::runtime_error(dir + ": cannot create folder: " + ec.message());
+    ExportedFiles e;
+    e.sidecar = (fs::path(dir) / (stem + ".json")).string();
+    // The GLSL first: a parameter it refuses (not a finite float) leaves no file.
+    const std::string glsl = generate_model_glsl(*mf->result().brdf, origin);
+    write_model_fit(mf->result(), e.sidecar);
+    e.glsl = (fs::path(dir) / (stem + ".glsl")).string();
+    AtomicBatch batch{fs::path(dir)};
+    write_text(batch.add(stem + ".glsl"), e.glsl, glsl);
+    batch.commit();
+    return e;
+  }
+  throw std::invalid_argument("export: method " + f.method() +
+                              " has no export (mccool, fit, search, svd, sh-k, sh-r and model-fit have)");
 }
+
+namespace {
+
+// The sidecar's text, checked as a regular file of at most kMaxTextFileBytes.
+json read_sidecar_json(const std::string& path) {
+  const std::string text = read_regular_file(path, kMaxTextFileBytes, "factorization sidecar");
+  try {
+    return json::parse(text);
+  } catch (const json::exception& e) {  // parse_error, and out_of_range for numbers like 1e400
+    throw std::invalid_argument(path + ": invalid JSON: " + e.what());
+  }
+}
+
 }  // namespace
+
+BrdfPtr load_export(const std::string& json_path) {
+  const json j = read_sidecar_json(json_path);
+  // A model fit's file (factor/model_fit.h) is a catalogue spec in JSON.
+  if (j.is_object() && j.contains("format") && j["format"] == kModelFitFormat) return load_model_fit(json_path);
+  // SVD / SH exports (factor/baseline_export.h) dispatch on the sidecar's method.
+  if (j.is_object() && j.contains("method") && j["method"].is_string() &&
+      is_baseline_method(j["method"].get<std::string>()))
+    return load_baseline_export(json_path);
+  return load_factorization(json_path);
+}
 
 void register_export_loader(Catalogue& cat) {
   cat.add_loader(".json", [](const std::string& path, const ParamDict& options) -> BrdfPtr {
     options.check_unused("factorization sidecar", {});
-    // A model fit's file (factor/model_fit.h) is a catalogue spec in JSON.
-    if (is_model_fit_file(path)) return load_model_fit(path);
-    // SVD / SH exports (factor/baseline_export.h) dispatch on the sidecar's method.
-    if (is_baseline_method(sidecar_method(path))) return load_baseline_export(path);
-    return load_factorization(path);
+    return load_export(path);
   });
 }
 

@@ -42,8 +42,9 @@ inline constexpr const char* kFactorExportFormat = "brdf-factor-factorization";
 struct ExportedFiles {
   std::string sidecar;                // DIR/STEM.json
   std::string glsl;                   // DIR/STEM.glsl
-  std::vector<std::string> textures;  // DIR/STEM_termK.exr, one per term
+  std::vector<std::string> textures;  // DIR/STEM_termK.exr, one per term (svd, sh-k: their EXRs)
   std::vector<std::string> previews;  // DIR/STEM_termK.png, one per term
+  std::string data;                   // DIR/STEM.f64 (svd, sh-k, sh-r; empty otherwise)
 };
 
 // Writes the export of `f` into `dir` (created if missing) with file names
@@ -79,6 +80,21 @@ ExportedFiles write_factorization(const HomomorphicFactorization& f, const std::
 inline constexpr size_t kMaxSidecarTerms = 1024;
 inline constexpr uint64_t kMaxSidecarTexels = uint64_t(1) << 26;  // 64 terms of 1024x1024
 std::shared_ptr<HomomorphicFactorization> load_factorization(const std::string& json_path);
+
+// The export of any factorization that has one, as a run writes it with
+// experiment.export on and Factorization.export() in Python: homomorphic
+// (mccool, fit, search, refined or not) by write_factorization; svd, sh-k,
+// sh-r by write_baseline_export (factor/baseline_export.h); model-fit as
+// STEM.json (write_model_fit) and STEM.glsl (generate_model_glsl, `origin` in
+// its header comment).
+// Throws std::invalid_argument naming the method when it has no export.
+ExportedFiles write_export(const Factorization& f, const std::string& dir, const std::string& stem,
+                           const std::string& origin = "");
+
+// Reads back what write_export wrote, from the sidecar STEM.json (dispatching
+// as the ".json" loader below does): a model fit's catalogue BRDF, or the
+// factorization. The file is checked as every reader's (brdfs/file_check.h).
+BrdfPtr load_export(const std::string& json_path);
 
 // Registers the ".json" loader, so a sidecar path works wherever a BRDF spec is
 // accepted (`--brdf results/run/factors.json`). It takes no options.

@@ -17,20 +17,31 @@
 #include <cstring>
 #include <cmath>
 #include <limits>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 
 namespace bf {
 
+namespace {
+// A number as the config reader shows it (12 significant digits).
+std::string shown_number(double v) {
+  std::ostringstream s;
+  s.precision(12);
+  s << v;
+  return s.str();
+}
+}  // namespace
+
 void FitOptions::validate() const {
   if (!(eps > 0.0 && eps <= 1.0))
     throw OptionError("eps", "eps: expected 0 < eps <= 1, found " + std::to_string(eps));
-  if (!(smoothing >= 0.0) || !std::isfinite(smoothing))
-    throw OptionError("smoothing", "smoothing: expected a finite value >= 0, found " +
-                                std::to_string(smoothing));
-  if (!(extrapolation_prior >= 0.0) || !std::isfinite(extrapolation_prior))
-    throw OptionError("extrapolation_prior", "extrapolation_prior: expected a finite value >= 0, found " +
-                                                 std::to_string(extrapolation_prior));
+  if (!(smoothing >= 0.0 && smoothing <= kMaxWeight))
+    throw OptionError("smoothing", "smoothing: expected a number in [0, " + shown_number(kMaxWeight) + "], found " +
+                                    shown_number(smoothing));
+  if (!(extrapolation_prior >= 0.0 && extrapolation_prior <= kMaxWeight))
+    throw OptionError("extrapolation_prior", "extrapolation_prior: expected a number in [0, " + shown_number(kMaxWeight) +
+                                                 "], found " + shown_number(extrapolation_prior));
   if (solve_last < 1)
     throw OptionError("solve_last", "solve_last: expected >= 1, found " + std::to_string(solve_last));
 }

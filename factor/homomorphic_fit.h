@@ -71,6 +71,12 @@ struct FitOptions {
   // crossovers, docs/speed.md "Dense against sparse, round 3"). ReferenceQR: the
   // simple path (dense B, Householder QR, no normal equations) for tests.
   enum class Solver { Auto, Dense, Sparse, ReferenceQR } solver = Solver::Auto;
+  // Upper bound of smoothing and extrapolation_prior (in mean sample weights).
+  // Far above it the Laplacian or the prior swamps the samples' rows of the
+  // normal matrix below double precision (1e300 overflows it), and the solve
+  // fails as "not positive definite" or returns textures the samples no
+  // longer shape; 1e6 still leaves the samples nine digits.
+  static constexpr double kMaxWeight = 1e6;
   // Throws std::invalid_argument naming the field, its value and the rule.
   void validate() const;
 };

@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <sstream>
 #include <stdexcept>
 #include <thread>
 #include <unordered_map>
@@ -129,15 +130,21 @@ void choose_linear_solver(RefineOptions::LinearSolver which, ceres::Solver::Opti
 
 void RefineOptions::validate() const {
   parse_objective(objective);
-  if (!(blend_weight >= 0.0) || !std::isfinite(blend_weight))
-    throw OptionError("blend_weight", "blend_weight: expected a finite value >= 0, found " +
-                                std::to_string(blend_weight));
+  const auto shown = [](double v) {
+    std::ostringstream s;
+    s.precision(12);
+    s << v;
+    return s.str();
+  };
+  if (!(blend_weight >= 0.0 && blend_weight <= kMaxWeight))
+    throw OptionError("blend_weight", "blend_weight: expected a number in [0, " + shown(kMaxWeight) + "], found " +
+                                          shown(blend_weight));
   if (max_iterations < 1)
     throw OptionError("max_iterations", "max_iterations: expected >= 1, found " +
                                 std::to_string(max_iterations));
-  if (!(smoothing >= 0.0) || !std::isfinite(smoothing))
-    throw OptionError("smoothing", "smoothing: expected a finite value >= 0, found " +
-                                std::to_string(smoothing));
+  if (!(smoothing >= 0.0 && smoothing <= kMaxWeight))
+    throw OptionError("smoothing", "smoothing: expected a number in [0, " + shown(kMaxWeight) + "], found " +
+                                       shown(smoothing));
   if (threads < 0)
     throw OptionError("threads", "threads: expected >= 0 (0 = all hardware threads), found " +
                                 std::to_string(threads));

@@ -81,6 +81,10 @@ struct RefineOptions {
   // available, else SuiteSparse, else CGNR; the others force one choice
   // (forcing an unavailable library throws).
   enum class LinearSolver { Auto, SuiteSparse, EigenSparse, CGNR } linear_solver = LinearSolver::Auto;
+  // Upper bound of blend_weight and smoothing, as FitOptions::kMaxWeight: far
+  // above it the weighted terms swamp the samples' residuals below double
+  // precision (1e300 overflows the cost).
+  static constexpr double kMaxWeight = 1e6;
   // Throws std::invalid_argument naming the field, its value and the rule.
   void validate() const;
 };

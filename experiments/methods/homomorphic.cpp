@@ -15,9 +15,10 @@ using nlohmann::json;
 
 std::vector<KeySpec> fit_keys(const KeySpec& texture_size) {
   return {texture_size,
-          num_key("smoothing", 0.0, kInf, false, "1e-3", "Laplacian weight relative to the mean sample weight per texel"),
+          num_key("smoothing", 0.0, FitOptions::kMaxWeight, false, "1e-3",
+                  "Laplacian weight relative to the mean sample weight per texel"),
           num_key("eps", 0.0, 1.0, true, "1e-5", "log-transform eps of the fit (docs/design.md §2)"),
-          num_key("extrapolation_prior", 0.0, kInf, false, "0",
+          num_key("extrapolation_prior", 0.0, FitOptions::kMaxWeight, false, "0",
                   "weight (in mean sample weights) pulling the fit toward the data's mean log value where no "
                   "sample lies (docs/design.md §3.2); 0 = off (pure Laplacian extrapolation)"),
           bool_key("clamp_log_range", "true",
@@ -36,10 +37,10 @@ KeySpec homomorphic_texture_key() {
 }
 
 std::vector<KeySpec> refine_keys() {
-  return {num_key("refine_blend", 0.0, kInf, false, "0.03",
+  return {num_key("refine_blend", 0.0, RefineOptions::kMaxWeight, false, "0.03",
                   "`blend` only: weight of the linear-space residuals against the log-space ones (0 = rel_mse alone)"),
           int_key("refine_iterations", 1, 100000, "50", "Levenberg–Marquardt iterations at most"),
-          num_key("refine_smoothing", 0.0, kInf, false, "the method's `smoothing`",
+          num_key("refine_smoothing", 0.0, RefineOptions::kMaxWeight, false, "the method's `smoothing`",
                   "Laplacian weight of the refinement, in the fit's units")};
 }
 
@@ -201,8 +202,7 @@ void fill_homomorphic_row(const RunContext& c, MethodOutcome& out, Row& row) {
 }
 
 void export_homomorphic(const RunContext& c, const MethodOutcome& out) {
-  const auto& run = std::any_cast<const HomomorphicRun&>(out.state);
-  write_factorization(*run.h, c.run_dir.string(), "factors");
+  write_export(*out.result, c.run_dir.string(), "factors");  // out.result is the run's (refined) fit
 }
 
 }  // namespace bf

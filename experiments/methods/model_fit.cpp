@@ -6,8 +6,8 @@
 
 #include "experiments/cli_util.h"
 #include "experiments/methods/method_kind.h"
+#include "factor/export.h"
 #include "factor/model_fit.h"
-#include "factor/model_glsl.h"
 #include "solvers/option_error.h"
 #include "solvers/parallel.h"
 
@@ -119,10 +119,7 @@ class ModelFitKind final : public MethodKind {
   }
 
   void export_files(const RunContext& c, const MethodOutcome& out) const override {
-    const auto mf = std::dynamic_pointer_cast<const ModelFitFactorization>(out.result);
-    write_model_fit(mf->result(), (c.run_dir / "model.json").string());
-    const std::string glsl = generate_model_glsl(*mf->result().brdf, "run " + c.run.run_id);
-    write_file_atomic((c.run_dir / "model.glsl").string(), [&](std::ostream& o) { o << glsl; });
+    write_export(*out.result, c.run_dir.string(), "model", "run " + c.run.run_id);
   }
 };
 

@@ -2,7 +2,7 @@
 #include "experiments/methods/tabulating.h"
 
 #include "brdfs/merl.h"
-#include "factor/baseline_export.h"
+#include "factor/export.h"
 #if __has_include("brdfs/measured.h")
 #include "brdfs/measured.h"
 #define BF_HAVE_MEASURED 1
@@ -29,7 +29,7 @@ void add_resampling_note(const RunContext& c, MethodOutcome& out) {
 
 void export_tabulated(const RunContext& c, const MethodOutcome& out) {
   write_description(c, out);
-  write_baseline_export(*out.result, c.run_dir.string(), "factors");
+  write_export(*out.result, c.run_dir.string(), "factors");
 }
 
 }  // namespace bf

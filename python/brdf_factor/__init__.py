@@ -13,6 +13,7 @@ with the same text the CLI prints after "brdf-factor: ". See docs/python.md.
 
 import csv as _csv
 import os as _os
+import stat as _stat
 
 from ._core import (  # noqa: F401  (the public API)
     Brdf,
@@ -136,6 +137,26 @@ def _value(text):
         return text
 
 
+_KINDS = ((_stat.S_ISFIFO, "a FIFO"), (_stat.S_ISCHR, "a character device"), (_stat.S_ISBLK, "a block device"),
+          (_stat.S_ISDIR, "a directory"), (_stat.S_ISSOCK, "a socket"))
+
+
+def _check_regular_file(path, what, max_bytes=2 << 30):
+    """The checks of brdfs/file_check.h, with its messages: a regular file of
+    at most max_bytes (a FIFO would block open(), a device never end)."""
+    try:
+        st = _os.stat(path)
+    except FileNotFoundError:
+        raise ValueError("%s: cannot open %s: file not found" % (path, what)) from None
+    except OSError as e:
+        raise ValueError("%s: cannot open %s: %s" % (path, what, e.strerror)) from None
+    if not _stat.S_ISREG(st.st_mode):
+        kind = next((k for test, k in _KINDS if test(st.st_mode)), "a non-regular file")
+        raise ValueError("%s: %s: expected a regular file, found %s" % (path, what, kind))
+    if st.st_size > max_bytes:
+        raise ValueError("%s: %s: %d bytes, more than the limit of %d" % (path, what, st.st_size, max_bytes))
+
+
 def results(path, frame=False):
     """An experiment folder's results.csv (or the file itself) as a list of
     dicts, one per run, numbers as int/float, empty cells as None; with
@@ -143,6 +164,7 @@ def results(path, frame=False):
     path = _os.fspath(path)
     if _os.path.isdir(path):
         path = _os.path.join(path, "results.csv")
+    _check_regular_file(path, "results table")
     with open(path, newline="") as f:
         rows = [{k: _value(v) for k, v in row.items()} for row in _csv.DictReader(f)]
     if frame:

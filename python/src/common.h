@@ -67,6 +67,10 @@ class LongCall {
   std::optional<py::gil_scoped_release> release_;
 };
 
+// metric_eps of a call that scores (score(), Factorization.score()), checked
+// as the config's experiment.metric_eps; messages start with `who`.
+double checked_metric_eps(const std::string& who, double eps);
+
 // nlohmann::json <-> Python objects (through the json module: small documents only).
 py::object to_python(const nlohmann::json& j);
 nlohmann::json to_json(const py::handle& o);

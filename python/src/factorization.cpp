@@ -1,11 +1,7 @@
 // Factorization objects in Python: evaluation (inherited from Brdf), metrics,
 // texture arrays, exports (EXR/PNG/JSON/GLSL, model-fit JSON, MERL) and reload.
-#include <filesystem>
-#include <fstream>
-
 #include "brdfs/merl.h"
 #include "common.h"
-#include "factor/baseline_export.h"
 #include "factor/export.h"
 #include "factor/homomorphic.h"
 #include "factor/model_fit.h"
@@ -24,6 +20,7 @@ py::dict exported_dict(const ExportedFiles& e) {
   d["glsl"] = e.glsl;
   d["textures"] = e.textures;
   d["previews"] = e.previews;
+  d["data"] = e.data.empty() ? py::object(py::none()) : py::object(py::str(e.data));
   return d;
 }
 
@@ -41,6 +38,7 @@ namespace {
 // metrics (docs/design.md §4) of `approx` on `s` as a dict, computed without
 // the GIL.
 py::dict score_dict(const Brdf& approx, const SampleSet& s, double eps) {
+  eps = checked_metric_eps("score", eps);
   Metrics mt;
   {
     py::gil_scoped_release release;
@@ -59,37 +57,18 @@ void bind_score_and_load(py::module_& m) {
   m.def(
       "load",
       [](const std::string& path) -> py::object {
-        std::string format, method;
-        {
-          std::ifstream in(path);
-          if (!in) throw std::invalid_argument(path + ": cannot open");
-          try {
-            const nlohmann::json j = nlohmann::json::parse(in);
-            format = j.is_object() ? j.value("format", "") : "";
-            method = j.is_object() && j.contains("method") && j["method"].is_string() ? j["method"].get<std::string>() : "";
-          } catch (const nlohmann::json::exception& e) {
-            throw std::invalid_argument(path + ": not a JSON file (" + e.what() + ")");
-          }
-        }
-        if (format == kModelFitFormat) {
-          auto b = std::make_shared<PyBrdf>();
-          b->brdf = load_model_fit(path);
-          return py::cast(b);
-        }
-        if (format == kFactorExportFormat && is_baseline_method(method)) {  // svd, sh-k, sh-r
-          std::shared_ptr<Factorization> b;
-          {
-            py::gil_scoped_release release;
-            b = load_baseline_export(path);
-          }
-          return py::cast(wrap(b));
-        }
-        std::shared_ptr<const HomomorphicFactorization> h;
+        // The CLI's `--brdf FILE.json` reader: the file checked as a regular
+        // file of bounded size (a FIFO or folder is refused at once, naming
+        // it), read without the GIL.
+        BrdfPtr b;
         {
           py::gil_scoped_release release;
-          h = load_factorization(path);
+          b = load_export(path);
         }
-        return py::cast(wrap(h));
+        if (auto f = std::dynamic_pointer_cast<const Factorization>(b)) return py::cast(wrap(f));
+        auto p = std::make_shared<PyBrdf>();
+        p->brdf = b;
+        return py::cast(p);
       },
       py::arg("path"),
       R"doc(Reads an export back: a factorization sidecar (STEM.json of mccool, fit,
@@ -156,28 +135,20 @@ and exports.)doc")
       .def(
           "export",
           [](const PyFactorization& f, const std::string& dir, const std::string& stem) -> py::dict {
-            if (auto h = homomorphic(f)) {
+            ExportedFiles e;
+            {
               py::gil_scoped_release release;
-              const ExportedFiles e = write_factorization(*h, dir, stem);
-              py::gil_scoped_acquire gil;
-              return exported_dict(e);
+              e = write_export(*f.f, dir, stem);  // what a run writes with experiment.export on
             }
-            if (auto mf = std::dynamic_pointer_cast<const ModelFitFactorization>(f.f)) {
-              const std::string path = dir + "/" + stem + ".json";
-              std::filesystem::create_directories(dir);
-              write_model_fit(mf->result(), path);
-              py::dict d;
-              d["sidecar"] = path;
-              return d;
-            }
-            throw std::invalid_argument("export: method " + f.f->method() +
-                                        " has no texture export (EXR/PNG/JSON/GLSL are written for mccool, fit and "
-                                        "search, a JSON for model-fit); export_merl() tabulates any factorization");
+            return exported_dict(e);
           },
           py::arg("dir"), py::arg("stem") = "factors",
-          R"doc(Writes the export into dir: homomorphic methods STEM_termK.exr/.png,
-STEM.json (sidecar), STEM.glsl; model-fit STEM.json. Returns the paths (dict).
-load(sidecar) reads it back (bit-identical evaluation).)doc")
+          R"doc(Writes the export into dir, as a run does with experiment.export on:
+mccool, fit, search: STEM_termK.exr/.png, STEM.json (sidecar), STEM.glsl;
+svd, sh-k, sh-r: STEM.f64 (every number the evaluation reads), STEM_*.exr
+(svd, sh-k), STEM.glsl, STEM.json; model-fit: STEM.json, STEM.glsl. Returns
+the paths (dict: sidecar, glsl, textures, previews, data). load(sidecar)
+reads any of them back (bit-identical evaluation).)doc")
       .def(
           "export_merl",
           [](const PyFactorization& f, const std::string& path) {

@@ -9,6 +9,7 @@
 // results row.
 #include <algorithm>
 #include <chrono>
+#include <sstream>
 #include <toml++/toml.h>
 
 #include "common.h"
@@ -168,6 +169,21 @@ MethodCall read_call(const std::string& kind, const py::kwargs& kw) {
   return call;
 }
 
+}  // namespace
+
+double checked_metric_eps(const std::string& who, double eps) {
+  toml::table experiment;
+  experiment.insert_or_assign("metric_eps", eps);
+  Ctx ctx;
+  ctx.path = who;
+  ctx.mark_define(experiment, who);
+  const ExperimentSettings e = read_experiment_table(experiment, ctx, who);
+  if (!ctx.issues.empty()) throw_issues(who, ctx.issues);
+  return e.metric_eps;
+}
+
+namespace {
+
 json choice_record(const SizeChoice& c) {
   json tried = json::array();
   for (const auto& t : c.tried) tried.push_back({{"value", t.value}, {"view_order", t.view_order}, {"error", t.error}});
@@ -256,9 +272,9 @@ std::shared_ptr<PyFactorization> run_refine(const PyFactorization& start, const 
   Reader r(ctx, c, "method", "refine");
   RefineOptions ro;
   ro.objective = r.choice("objective", ro.objective, {"linear", "cosine", "blend"});
-  ro.blend_weight = r.number("blend_weight", ro.blend_weight, 0.0, kInf);
+  ro.blend_weight = r.number("blend_weight", ro.blend_weight, 0.0, RefineOptions::kMaxWeight);
   ro.max_iterations = static_cast<int>(r.integer("max_iterations", ro.max_iterations, 1, 100000));
-  ro.smoothing = r.number("smoothing", ro.smoothing, 0.0, kInf);
+  ro.smoothing = r.number("smoothing", ro.smoothing, 0.0, RefineOptions::kMaxWeight);
   ro.threads = static_cast<int>(r.integer("threads", ro.threads, 0, 1024));
   ro.function_tolerance = r.number("function_tolerance", ro.function_tolerance, 0.0, kInf, true);
   const std::string ls = r.choice("linear_solver", "auto", {"auto", "suitesparse", "eigen_sparse", "cgnr"});
@@ -352,6 +368,20 @@ theta_i_nodes, theta_o_nodes, phi_nodes, min_cos, tolerance (needs samples)).)do
 Ceres fit of an analytic model. Options: the keys of kind = "model-fit"
 (model, metric, cube_root, anisotropic, lobes, eps, starts, seed,
 max_iterations, threads).)doc");
+  m.def(
+      "_method_examples",
+      [] {
+        // Every registered kind with its small, fast example options (what
+        // the catalogue test runs), for tests that must cover every kind.
+        py::dict out;
+        for (const auto& k : method_kinds()) {
+          std::ostringstream js;
+          js << toml::json_formatter{toml::parse(k->example())};
+          out[py::str(k->name())] = to_python(json::parse(js.str()));
+        }
+        return out;
+      },
+      "{kind: example options} of every registered method kind (tests).");
   m.def("refine", &run_refine, py::arg("factorization"), py::arg("samples"),
         R"doc(refine(factorization, samples, **options) -> Factorization
 

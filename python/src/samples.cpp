@@ -2,6 +2,8 @@
 // measured samples, and sets built from numpy arrays. wi, wo, value, weight and
 // valid are read-only numpy views of the C++ vectors (no copies).
 #include <cmath>
+#include <limits>
+#include <optional>
 
 #include "brdfs/measured.h"
 #include "brdfs/sample_csv.h"
@@ -25,6 +27,33 @@ py::array vec3_view(const py::object& owner, const std::vector<Vec3>& v) {
   return view(owner, v.data(), py::dtype::of<double>(), {py::ssize_t(v.size()), 3}, {py::ssize_t(sizeof(Vec3)), 8});
 }
 
+// "(3, 2)" for an array, the type's name for anything else (messages).
+std::string found_shape(const py::handle& in, const py::array& a) {
+  if (!a) return std::string(py::str(py::type::of(in).attr("__name__")));
+  std::string shape = "(";
+  for (py::ssize_t d = 0; d < a.ndim(); ++d) shape += (d ? ", " : "") + std::to_string(a.shape(d));
+  return shape + (a.ndim() == 1 ? ",)" : ")");
+}
+
+// Unit length, kept as given when already unit (to 1e-14); scaled by the
+// largest component first, so that a finite non-zero vector whose squared
+// norm over- or underflows (1e300, 1e-300) is still a direction.
+void normalize_direction(Vec3& w) {
+  const double l = w.norm();
+  if (std::abs(l - 1.0) <= 1e-14) return;
+  if (std::isfinite(l) && l > 1e-150) {
+    w /= l;
+    return;
+  }
+  const double m = w.cwiseAbs().maxCoeff();
+  if (!(m > 0.0) || !std::isfinite(m)) {
+    w.setConstant(std::numeric_limits<double>::quiet_NaN());
+    return;
+  }
+  const Vec3 u = w / m;
+  w = u / u.norm();
+}
+
 SamplesPtr from_arrays(const py::handle& wi_in, const py::handle& wo_in, const py::handle& value_in,
                        const py::object& weight_in, const std::string& description) {
   auto wi = directions_array(wi_in, "wi");
@@ -36,13 +65,17 @@ SamplesPtr from_arrays(const py::handle& wi_in, const py::handle& wo_in, const p
                                 std::to_string(n) + ", " + std::to_string(wo.shape(0)) + ", " +
                                 std::to_string(value.shape(0)));
   if (n == 0) throw std::invalid_argument("SampleSet: expected at least one sample, found 0 rows");
-  py::array_t<double, py::array::c_style | py::array::forcecast> weight;
+  // No weight: the set has none (every weight 1, SampleSet::weight_of), never
+  // a vector read from an array that does not hold n values.
+  std::optional<py::array_t<double, py::array::c_style | py::array::forcecast>> weight;
   if (!weight_in.is_none()) {
-    weight = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(weight_in);
-    if (!weight || weight.ndim() != 1 || weight.shape(0) != n) {
+    auto w = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(weight_in);
+    if (!w || w.ndim() != 1 || w.shape(0) != n) {
       PyErr_Clear();
-      throw std::invalid_argument("SampleSet: weight: expected shape (" + std::to_string(n) + ",) (one per sample)");
+      throw std::invalid_argument("SampleSet: weight: expected shape (" + std::to_string(n) +
+                                  ",) (one per sample), found " + found_shape(weight_in, w));
     }
+    weight = std::move(w);
   }
   auto s = std::make_shared<SampleSet>();
   s->wi.resize(n);
@@ -52,13 +85,12 @@ SamplesPtr from_arrays(const py::handle& wi_in, const py::handle& wo_in, const p
   std::copy_n(wo.data(), 3 * n, s->wo.front().data());
   std::copy_n(value.data(), 3 * n, s->value.front().data());
   for (py::ssize_t k = 0; k < n; ++k) {
-    // Directions are normalized as in Brdf.eval (unit ones kept as given); zero ones
-    // become NaN and are masked by validate() as below the horizon.
-    const double li = s->wi[k].norm(), lo = s->wo[k].norm();
-    if (std::abs(li - 1.0) > 1e-14) s->wi[k] /= li;
-    if (std::abs(lo - 1.0) > 1e-14) s->wo[k] /= lo;
+    // Directions are normalized as in Brdf.eval (unit ones kept as given); zero
+    // and non-finite ones become NaN and are masked by validate() as below the horizon.
+    normalize_direction(s->wi[k]);
+    normalize_direction(s->wo[k]);
   }
-  if (weight) s->weight.assign(weight.data(), weight.data() + n);
+  if (weight) s->weight.assign(weight->data(), weight->data() + n);
   s->description = description;
   s->validate();
   return s;

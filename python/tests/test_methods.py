@@ -145,10 +145,10 @@ def test_unknown_and_mistyped_options_are_named(grid8):
     # Every problem of a call is reported, each on its own line, as the CLI lists them.
     with pytest.raises(ValueError) as e:
         bf.mccool(grid8, smoothing=-1.0, solve_last=0)
-    assert str(e.value).splitlines() == ["mccool: smoothing: expected a number >= 0, found -1",
+    assert str(e.value).splitlines() == ["mccool: smoothing: expected a number in [0, 1000000], found -1",
                                          "mccool: solve_last: expected an integer in 1..64, found 0"]
     # Ranges as the config reader words them, and rules of the options' validate().
-    with pytest.raises(ValueError, match=r"^mccool: smoothing: expected a number >= 0, found -1$"):
+    with pytest.raises(ValueError, match=r"^mccool: smoothing: expected a number in \[0, 1000000\], found -1$"):
         bf.mccool(grid8, smoothing=-1.0)
     with pytest.raises(ValueError, match=r"^search: beam: expected 1..\(restarts \+ guesses\) = 1..2, found 9$"):
         bf.search(grid8, restarts=2, beam=9)
@@ -176,8 +176,6 @@ def test_export_reload_is_bit_identical(tmp_path, grid8):
     merl = str(tmp_path / "paint.binary")
     f.export_merl(merl)
     assert os.path.getsize(merl) == 34992012
-    with pytest.raises(ValueError, match=r"^export: method svd has no texture export"):
-        bf.svd(bf.brdf("lambert"), terms=1, texture_size=8).export(str(tmp_path))
 
 
 def test_factor_dispatches_by_kind(grid8, bluepaint):

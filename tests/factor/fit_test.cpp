@@ -9,6 +9,7 @@
 #include "brdfs/sampleset.h"
 #include "factor/homomorphic_fit.h"
 #include "factor/metrics.h"
+#include "factor/refine.h"
 #include "fit_helpers.h"
 #include "test_common.h"
 
@@ -419,4 +420,37 @@ TEST_CASE("fit: the exposed normal matrix is symmetric and sums to the sample we
   size_t m2 = 0;
   CHECK(joint_normal_matrix(d, one, opt, 10, &m2).size() == 0);
   CHECK(m2 == m);
+}
+
+TEST_CASE("fit options: huge weights are refused naming the key and the bound still fits") {
+  {
+    FitOptions o;
+    o.smoothing = 1e300;
+    CHECK_THROWS_WITH(o.validate(), "smoothing: expected a number in [0, 1000000], found 1e+300");
+    o.smoothing = 1e-3;
+    o.extrapolation_prior = 1e300;
+    CHECK_THROWS_WITH(o.validate(), "extrapolation_prior: expected a number in [0, 1000000], found 1e+300");
+  }
+  {
+    RefineOptions r;
+    r.blend_weight = 1e300;
+    CHECK_THROWS_WITH(r.validate(), "blend_weight: expected a number in [0, 1000000], found 1e+300");
+    r.blend_weight = 0.03;
+    r.smoothing = 2e6;
+    CHECK_THROWS_WITH(r.validate(), "smoothing: expected a number in [0, 1000000], found 2000000");
+  }
+  // At the bound, each weight still gives a finite fit (the solve keeps the samples' digits).
+  const McCoolFormBrdf brdf;
+  const SampleSet s = sample_stratified(brdf, 3000, 3);
+  for (int which = 0; which < 2; ++which) {
+    FitOptions opt;
+    (which == 0 ? opt.smoothing : opt.extrapolation_prior) = FitOptions::kMaxWeight;
+    REQUIRE_NOTHROW(opt.validate());
+    const FitData d(s, opt.eps);
+    const auto f = fit_homomorphic(d, mccool_terms(8), opt, "mccool");
+    const double e = evaluate_metrics(*f, s, d.transform).rel_mse;
+    INFO("weight " << which << ": rel_mse " << e);
+    CHECK(std::isfinite(e));
+    CHECK(e < 10.0);
+  }
 }
