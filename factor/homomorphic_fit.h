@@ -56,7 +56,7 @@ struct FitOptions {
   int solve_last = 2;        // n: the last n terms are solved jointly, >= 1
   // rho: weight (in mean sample weights) of the bounded-extrapolation prior
   // (header comment, docs/design.md §3.2); 0 = off (pure Laplacian
-  // extrapolation, the rule before issue #15). Finite, >= 0.
+  // extrapolation, the earlier default). Finite, >= 0.
   double extrapolation_prior = 0.0;
   // Log-range clamp (docs/design.md §3.2): the factorization clamps its summed
   // log value s_c to [min g_c, max g_c] over the valid training samples
