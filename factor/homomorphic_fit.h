@@ -51,12 +51,12 @@ namespace bf {
 
 struct FitOptions {
   double eps = 1e-5;         // log-transform epsilon (docs/design.md §2), 0 < eps <= 1
-  double smoothing = 1e-3;   // Laplacian weight relative to the mean sample weight per texel, >= 0
+  double smoothing = 1e-3;   // Laplacian weight relative to the mean sample weight per texel, in [0, kMaxWeight]
   bool subtract_eps = true;  // reconstruct A exp(s) - eps A (clamped at 0) instead of A exp(s)
   int solve_last = 2;        // n: the last n terms are solved jointly, >= 1
   // rho: weight (in mean sample weights) of the bounded-extrapolation prior
   // (header comment, docs/design.md §3.2); 0 = off (pure Laplacian
-  // extrapolation, the earlier default). Finite, >= 0.
+  // extrapolation, the earlier default). In [0, kMaxWeight].
   double extrapolation_prior = 0.0;
   // Log-range clamp (docs/design.md §3.2): the factorization clamps its summed
   // log value s_c to [min g_c, max g_c] over the valid training samples
