@@ -631,9 +631,15 @@ RunSummary run_experiment(const RunOptions& opt, std::ostream& out, std::ostream
     err << "experiment " << plan.experiment.name << ": " << sum.in_shard << " runs";
     if (opt.shards > 1) err << " in shard " << opt.shard << "/" << opt.shards << " (of " << plan.runs.size() << ")";
     err << ": " << n_run << " to do, " << n_cached << " cached";
-    size_t redo = 0;
-    for (Action a : action) redo += a == Action::Redo;
-    if (redo) err << " (" << redo << " unfinished, redone)";
+    size_t redo = 0, untrusted_runs = 0;
+    for (size_t i = 0; i < action.size(); ++i) {
+      redo += action[i] == Action::Redo;
+      untrusted_runs += !untrusted[i].empty();
+    }
+    if (redo)
+      err << " (" << redo << " unfinished"
+          << (untrusted_runs ? ", " + std::to_string(untrusted_runs) + " of them not trusted" : std::string())
+          << ", redone)";
     err << "; " << jobs << " job slot" << (jobs > 1 ? "s" : "") << " -> " << dir << "\n";
   }
 

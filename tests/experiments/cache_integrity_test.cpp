@@ -9,7 +9,9 @@
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <cstring>
+#include <functional>
 #include <limits>
+#include <map>
 #include <nlohmann/json.hpp>
 
 #include "experiments/config.h"
@@ -230,13 +232,15 @@ TEST_CASE("cache integrity: non-finite values, bad flags and wrong counts in the
       {"a masked count that disagrees", [&](std::string& b, const Layout&) { b[24] = 3; }},
       {"the wrong description text", [&](std::string& b, const Layout& l) { if (l.dlen) b[56] = '\x01'; }},
   };
+  Fixture f;  // one clean run; each edit starts from its cache
+  const fs::path cache = cache_file(f.out);
+  const std::string clean_bytes = read_bytes(cache_file(f.clean));
   for (const auto& [what, edit] : edits) {
     INFO(what);
-    Fixture f;
-    const fs::path cache = cache_file(f.out);
-    std::string b = read_bytes(cache);
+    std::string b = clean_bytes;
     edit(b, layout_of(b));
     resign(b);
+    REQUIRE(b != clean_bytes);
     write_bytes(cache, b);
     int code = 0;
     const std::string text = f.rerun_without_runs(&code);
