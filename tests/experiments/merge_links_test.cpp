@@ -26,7 +26,7 @@ void snapshot_into(const fs::path& root, const fs::path& dir, std::map<std::stri
   std::error_code ec;
   for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
     const fs::path p = it->path();
-    const std::string rel = fs::relative(p, root).string();
+    const std::string rel = p.lexically_relative(root).string();
     const auto st = fs::symlink_status(p, ec);
     if (fs::is_symlink(st)) {
       s[rel] = "-> " + fs::read_symlink(p, ec).string();
