@@ -5,6 +5,9 @@
 #include <unistd.h>
 
 #include <atomic>
+#include <chrono>
+#include <cstdlib>
+#include <thread>
 
 #include "solvers/cancel.h"
 
@@ -52,6 +55,22 @@ InterruptScope::~InterruptScope() {
 }
 
 int interrupt_signal() { return g_signal.load(); }
+
+namespace {
+std::atomic<bool> g_hook_fired{false};
+std::atomic<bool> g_runs_taken{false};
+}  // namespace
+
+void test_signal_at_run_end() {
+  static const bool enabled = std::getenv("BF_TEST_SIGNAL_AT_RUN_END") != nullptr;
+  if (!enabled || g_hook_fired.exchange(true)) return;
+  ::raise(SIGINT);
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+  while (!g_runs_taken.load() && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+}
+
+void note_finished_runs_taken() { g_runs_taken = true; }
 
 std::string signal_name(int sig) {
   if (sig == SIGINT) return "SIGINT";

@@ -24,6 +24,15 @@ class InterruptScope {
 // The signal received since the scope was entered (SIGINT, SIGTERM), or 0.
 int interrupt_signal();
 
+// Test hook for the race between a finishing run and a signal (docs/robustness.md
+// "Interrupt race"). With the environment variable BF_TEST_SIGNAL_AT_RUN_END
+// set, the first call raises SIGINT and then waits, at most 10 s, until
+// note_finished_runs_taken() is called; every other call returns at once. The
+// runner calls it when a run's files are written, before its DONE marker.
+void test_signal_at_run_end();
+// The runner has taken its list of finished runs after a signal (releases the hook).
+void note_finished_runs_taken();
+
 // "SIGINT", "SIGTERM" or "signal N".
 std::string signal_name(int sig);
 

@@ -169,8 +169,11 @@ void set_presentation(Row& row, const Plan& plan, const PlannedRun& r) {
   row["sampling"] = plan.samplings[r.sampling].label;
 }
 
+// Executes one run and writes its files and run.json; the caller writes the
+// DONE marker (done_marker, write_done_marker). cache_notes: what was found
+// wrong with caches this run would have used (rebuilt), for its notes.
 RunEntry execute_run(const Plan& plan, const PlannedRun& pr, const SampleSet& samples, const fs::path& exp_dir,
-                     RenderCache& renders, const json& build) {
+                     RenderCache& renders, const json& build, const std::vector<std::string>& cache_notes) {
   const BrdfVariant& b = plan.brdfs[pr.brdf];
   const MethodKind& kind = *plan.methods[pr.method].impl;
   const fs::path run_dir = exp_dir / "runs" / pr.run_id;
@@ -212,6 +215,8 @@ RunEntry execute_run(const Plan& plan, const PlannedRun& pr, const SampleSet& sa
   kind.fill_row(c, out, row);
   std::vector<std::string> notes = out.notes;
   fill_common_columns(c, out, mt, seconds, row, notes, rec);
+  if (!cache_notes.empty()) rec["cache_rebuilt"] = cache_notes;
+  notes.insert(notes.end(), cache_notes.begin(), cache_notes.end());
   {  // Validation on data the fit never saw, and its flags.
     const auto tv = Clock::now();
     const ValidationScores vs = score_validation(*out.result, domain.get(), split ? &split->held : nullptr, lt);
@@ -244,7 +249,7 @@ RunEntry execute_run(const Plan& plan, const PlannedRun& pr, const SampleSet& sa
   rec["notes"] = notes;
   rec["wall_seconds"] = since(wall0);
   rec["build"] = build;
-  e.files = finish_run_folder(exp_dir, run_dir, pr.run_id, row, rec);
+  e.files = write_run_record(exp_dir, run_dir, pr.run_id, row, rec);
   e.record = rec;
   return e;
 }
@@ -291,7 +296,8 @@ struct PoolEnd {
 // holds the finished ones (a snapshot, under the pool's lock).
 PoolEnd execute_in_parallel(const Plan& plan, const std::vector<size_t>& todo, int jobs,
                             const std::map<std::string, std::shared_ptr<const SampleSet>>& samples,
-                            const fs::path& exp_dir, const json& build, const RunOptions& opt, std::ostream& err,
+                            const std::vector<std::vector<std::string>>& run_notes, const fs::path& exp_dir,
+                            const json& build, const RunOptions& opt, std::ostream& err,
                             std::vector<RunEntry>& entries) {
   // The pool's state outlives this call when workers are abandoned (detached).
   struct State {
@@ -301,6 +307,7 @@ PoolEnd execute_in_parallel(const Plan& plan, const std::vector<size_t>& todo, i
     int free_slots = 0;
     size_t next = 0, done = 0;
     int busy = 0, exited = 0;  // workers inside a run; workers that returned
+    bool closed = false;       // the snapshot of finished runs is taken: no run finishes after it
     std::vector<RunEntry> entries;
   };
   auto st = std::make_shared<State>();
@@ -308,7 +315,7 @@ PoolEnd execute_in_parallel(const Plan& plan, const std::vector<size_t>& todo, i
   st->entries = entries;
   const auto start = Clock::now();
   const size_t total = todo.size();
-  auto work = [&plan, &todo, jobs, &samples, &exp_dir, &build, &opt, &err, start, total](State& s) {
+  auto work = [&plan, &todo, jobs, &samples, &run_notes, &exp_dir, &build, &opt, &err, start, total](State& s) {
     for (;;) {
       size_t i;
       int w;
@@ -333,32 +340,52 @@ PoolEnd execute_in_parallel(const Plan& plan, const std::vector<size_t>& todo, i
       const PlannedRun& r = plan.runs[i];
       const auto t0 = Clock::now();
       RunEntry e;
+      // The failed row of run r (its folder removed).
+      auto failed = [&](const std::exception& ex) {
+        std::error_code ec;
+        fs::remove_all(exp_dir / "runs" / r.run_id, ec);
+        RunEntry f;
+        f.run_id = r.run_id;
+        f.status = "failed";
+        set_presentation(f.row, plan, r);
+        f.row["status"] = "failed";
+        const bool oom = dynamic_cast<const std::bad_alloc*>(&ex) != nullptr;  // never "std::bad_alloc" alone
+        f.row["notes"] = std::string("failed: ") + (oom ? "out of memory" : ex.what());
+        f.record = {{"run_id", r.run_id}, {"error", ex.what()}, {"method", plan.methods[r.method].options}};
+        return f;
+      };
+      std::string marker;  // the DONE marker of a run whose files are written
       try {
-        e = execute_run(plan, r, *samples.at(r.samples_key), exp_dir, s.renders, build);
+        e = execute_run(plan, r, *samples.at(r.samples_key), exp_dir, s.renders, build, run_notes[i]);
+        marker = done_marker(exp_dir, r.run_id, e.files);
       } catch (const std::exception& ex) {
         std::error_code ec;
         fs::remove_all(exp_dir / "runs" / r.run_id, ec);
         e = RunEntry{};
         // Cancelled by a signal (RunOptions::cancel_on_signal): left empty, so
         // marked interrupted below with the runs not started.
-        if (!(dynamic_cast<const Cancelled*>(&ex) && interrupt_signal())) {
-          e.run_id = r.run_id;
-          e.status = "failed";
-          set_presentation(e.row, plan, r);
-          e.row["status"] = "failed";
-          const bool oom = dynamic_cast<const std::bad_alloc*>(&ex) != nullptr;  // never "std::bad_alloc" alone
-          e.row["notes"] = std::string("failed: ") + (oom ? "out of memory" : ex.what());
-          e.record = {{"run_id", r.run_id}, {"error", ex.what()}, {"method", plan.methods[r.method].options}};
-        }
+        if (!(dynamic_cast<const Cancelled*>(&ex) && interrupt_signal())) e = failed(ex);
       }
+      if (!marker.empty()) test_signal_at_run_end();
       e.shard = opt.shard;
       {
         std::unique_lock<std::mutex> lk(s.mu);
-        s.entries[i] = std::move(e);
+        // The run is finished (DONE) and listed ok together, under the lock
+        // the tables' snapshot takes: once the snapshot is taken (a signal),
+        // a run that ends stays unfinished, as the tables list it.
+        const bool too_late = s.closed;
+        if (!marker.empty() && !too_late) {
+          try {
+            write_done_marker(exp_dir / "runs" / r.run_id, marker);
+          } catch (const std::exception& ex) {
+            e = failed(ex);
+          }
+        }
+        if (!too_late) s.entries[i] = std::move(e);
         s.free_slots += w;
         --s.busy;
         ++s.done;
-        if (!opt.quiet) {
+        if (!opt.quiet && !too_late) {
           const double el = since(start);
           const double eta = s.done < total ? el / s.done * (total - s.done) : 0.0;
           err << "[" << s.done << "/" << total << "] " << (s.entries[i].status == "ok" ? "done " : "FAILED ")
@@ -394,7 +421,9 @@ PoolEnd execute_in_parallel(const Plan& plan, const std::vector<size_t>& todo, i
       if (!end.abandon)
         while (st->exited < n_threads) st->cv.wait_for(lk, std::chrono::milliseconds(100));
     }
-    entries = st->entries;  // a snapshot: abandoned workers may still write theirs
+    entries = st->entries;  // a snapshot: abandoned workers finish no run after it
+    st->closed = true;
+    if (end.stopped_by) note_finished_runs_taken();
   }
   for (auto& t : pool) {
     if (end.abandon) t.detach();  // the process ends without returning (run_experiment, _Exit)
@@ -443,11 +472,14 @@ void print_dry_run(const Plan& plan, const std::vector<Action>& action, const st
       << " of other shards\n";
 }
 
-// The samples of the runs to do, by sample key (cache/samples/ in the folder).
+// The samples of the runs to do, by sample key (cache/samples/ in the folder);
+// a cache entry that was refused and rebuilt is warned about on err and its
+// problem kept in `rebuilt` (by sample key) for the notes of its runs.
 std::map<std::string, std::shared_ptr<const SampleSet>> prepare_samples(const Plan& plan,
                                                                         const std::vector<Action>& action,
                                                                         const fs::path& exp_dir,
-                                                                        const RunOptions& opt, std::ostream& err) {
+                                                                        const RunOptions& opt, std::ostream& err,
+                                                                        std::map<std::string, std::string>& rebuilt) {
   std::map<std::string, std::shared_ptr<const SampleSet>> samples;
   const fs::path cache_dir = exp_dir / "cache" / "samples";
   fs::create_directories(cache_dir);
@@ -456,7 +488,12 @@ std::map<std::string, std::shared_ptr<const SampleSet>> prepare_samples(const Pl
     if (action[i] == Action::Cached || action[i] == Action::OtherShard || samples.count(r.samples_key)) continue;
     const auto t0 = Clock::now();
     bool hit = false;
-    samples[r.samples_key] = make_samples(plan, r, cache_dir, opt.force, &hit);
+    std::string problem;
+    samples[r.samples_key] = make_samples(plan, r, cache_dir, opt.force, &hit, &problem);
+    if (!problem.empty()) {
+      err << "brdf-factor: warning: sample cache " << problem << ": not trusted, resampled\n";
+      rebuilt[r.samples_key] = problem;
+    }
     if (!opt.quiet)
       err << "samples: " << plan.brdfs[r.brdf].label << " | " << plan.samplings[r.sampling].label << ": "
           << samples[r.samples_key]->summary() << (hit ? " (cached)" : "") << " in " << hms(since(t0)) << "\n";
@@ -465,10 +502,14 @@ std::map<std::string, std::shared_ptr<const SampleSet>> prepare_samples(const Pl
 }
 
 // What each run of this shard needs: cached runs' entries go to `cached`,
-// this shard's run ids and count to `sum`.
+// this shard's run ids and count to `sum`. A finished run that fails
+// verification (load_done_run) is redone: warned about on err, its problem
+// kept in `untrusted` (by plan index) for its notes.
 std::vector<Action> decide_actions(const Plan& plan, const fs::path& exp_dir, const RunOptions& opt,
-                                   RunSummary& sum, std::vector<std::optional<RunEntry>>& cached) {
+                                   RunSummary& sum, std::vector<std::optional<RunEntry>>& cached,
+                                   std::vector<std::string>& untrusted, std::ostream& err) {
   std::vector<Action> action(plan.runs.size());
+  untrusted.assign(plan.runs.size(), "");
   for (size_t i = 0; i < plan.runs.size(); ++i) {
     const PlannedRun& r = plan.runs[i];
     if (static_cast<int>(i % opt.shards) != opt.shard - 1) {
@@ -477,9 +518,11 @@ std::vector<Action> decide_actions(const Plan& plan, const fs::path& exp_dir, co
     }
     sum.run_ids.push_back(r.run_id);
     ++sum.in_shard;
-    cached[i] = load_done_run(exp_dir, r.run_id);
+    cached[i] = load_done_run(exp_dir, r.run_id, &untrusted[i]);
     if (cached[i]) action[i] = opt.force ? Action::Forced : Action::Cached;
     else action[i] = incomplete_folder(exp_dir, r.run_id) ? Action::Redo : Action::Run;
+    if (!untrusted[i].empty())
+      err << "brdf-factor: warning: run " << r.run_id << ": " << untrusted[i] << ": not trusted, the run is redone\n";
   }
   return action;
 }
@@ -559,7 +602,8 @@ RunSummary run_experiment(const RunOptions& opt, std::ostream& out, std::ostream
   }
 
   std::vector<std::optional<RunEntry>> cached(plan.runs.size());
-  const std::vector<Action> action = decide_actions(plan, exp_dir, opt, sum, cached);
+  std::vector<std::string> untrusted;
+  const std::vector<Action> action = decide_actions(plan, exp_dir, opt, sum, cached, untrusted, err);
   size_t n_run = 0, n_cached = 0, n_other = 0;
   for (Action a : action) {
     if (a == Action::Cached) ++n_cached;
@@ -588,14 +632,28 @@ RunSummary run_experiment(const RunOptions& opt, std::ostream& out, std::ostream
     err << "experiment " << plan.experiment.name << ": " << sum.in_shard << " runs";
     if (opt.shards > 1) err << " in shard " << opt.shard << "/" << opt.shards << " (of " << plan.runs.size() << ")";
     err << ": " << n_run << " to do, " << n_cached << " cached";
-    size_t redo = 0;
-    for (Action a : action) redo += a == Action::Redo;
-    if (redo) err << " (" << redo << " unfinished, redone)";
+    size_t redo = 0, untrusted_runs = 0;
+    for (size_t i = 0; i < action.size(); ++i) {
+      redo += action[i] == Action::Redo;
+      untrusted_runs += !untrusted[i].empty();
+    }
+    if (redo)
+      err << " (" << redo << " unfinished"
+          << (untrusted_runs ? ", " + std::to_string(untrusted_runs) + " of them not trusted" : std::string())
+          << ", redone)";
     err << "; " << jobs << " job slot" << (jobs > 1 ? "s" : "") << " -> " << dir << "\n";
   }
 
   // Samples for the runs to do.
-  const auto samples = prepare_samples(plan, action, exp_dir, opt, err);
+  std::map<std::string, std::string> rebuilt;
+  const auto samples = prepare_samples(plan, action, exp_dir, opt, err, rebuilt);
+  // What was found wrong with the caches each run would have used (its notes).
+  std::vector<std::vector<std::string>> run_notes(plan.runs.size());
+  for (size_t i = 0; i < plan.runs.size(); ++i) {
+    if (!untrusted[i].empty()) run_notes[i].push_back("redone: " + untrusted[i] + " (not trusted)");
+    if (auto it = rebuilt.find(plan.runs[i].samples_key); it != rebuilt.end())
+      run_notes[i].push_back("samples rebuilt: " + it->second + " (not trusted)");
+  }
 
   // Execute.
   std::vector<RunEntry> entries(plan.runs.size());
@@ -609,7 +667,8 @@ RunSummary run_experiment(const RunOptions& opt, std::ostream& out, std::ostream
     }
   }
   const auto start = Clock::now();
-  const PoolEnd pool_end = execute_in_parallel(plan, todo, jobs, samples, exp_dir, build, opt, err, entries);
+  const PoolEnd pool_end =
+      execute_in_parallel(plan, todo, jobs, samples, run_notes, exp_dir, build, opt, err, entries);
   const int stopped_by = pool_end.stopped_by;
   const size_t unfinished = stopped_by ? mark_interrupted(plan, todo, stopped_by, opt.shard, entries) : 0;
 
