@@ -12,6 +12,8 @@ them as plain text (no mathtext or TeX).
 import json
 import sys
 
+from plot_results import plain  # the same script folder: labels drawn as plain text
+
 
 def label(j):
     s = f"{j['optimizer']} r{j['restarts']}"
@@ -34,16 +36,6 @@ def md_cell(s):
         else:
             out.append({"&": "&amp;", "<": "&lt;", ">": "&gt;"}.get(c, c))
     return "".join(out)
-
-
-def plain(text):
-    """Draws a matplotlib Text as the characters it holds (no mathtext, no TeX)."""
-    text.set_usetex(False)
-    if hasattr(text, "set_parse_math"):  # matplotlib >= 3.5
-        text.set_parse_math(False)
-    else:
-        text.set_text(text.get_text().replace("$", r"\$"))
-    return text
 
 
 def main(argv):
