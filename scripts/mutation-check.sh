@@ -37,6 +37,7 @@ mutations=(
   'split-planes-b-without-off|search/structure.cpp|s/double b = all - off - a;/double b = all - a;/'
   'reader-theta-up-to-pi|brdfs/measured_readers.cpp|s/v <= M_PI \/ 2 \+ kTol/v <= M_PI + kTol/'
   'csv-wi-below-horizon-used|brdfs/sampleset.cpp|s/if \(!\(wi\[k\]\.z\(\) > 0\.0\) \x7c\x7c /if (/'
+  'run-id-without-holdout|experiments/config.cpp|s/\{"holdout", plan\.experiment\.holdout\},\n\s*//'
 )
 
 # The independent sample (docs/testing.md, "Independent sample"):
