@@ -38,7 +38,7 @@ TEST_CASE("refine: invalid options name the field, value and rule") {
   REQUIRE_THROWS_WITH(o.validate(), Contains("objective") && Contains("'l2'"));
   o = RefineOptions{};
   o.blend_weight = -1;
-  REQUIRE_THROWS_WITH(o.validate(), Contains("blend_weight") && Contains(">= 0"));
+  REQUIRE_THROWS_WITH(o.validate(), Contains("blend_weight") && Contains("[0, 1000000]") && Contains("found -1"));
   o = RefineOptions{};
   o.max_iterations = 0;
   REQUIRE_THROWS_WITH(o.validate(), Contains("max_iterations"));
