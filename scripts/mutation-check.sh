@@ -71,6 +71,20 @@ sample=(
   'r5-spectral-phi-swapped|brdfs/measured_readers.cpp|s/from_spherical\(a\[2\], a\[3\]\)/from_spherical(a[2], a[1])/|test_brdfs|~[slow]'
 )
 
+# Plants mutation $1 (name) in file $2 with perl substitution $3 and shows the
+# changed lines; exits 2 when the file has local changes or the substitution
+# does not apply.
+plant() {
+  local name=$1 file=$2 subst=$3
+  git diff --quiet -- "$file" || { echo "mutation-check: $file has local changes: commit or stash them" >&2; exit 2; }
+  cp "$file" "$log_dir/orig"
+  perl -0pi -e "$subst" "$file"
+  if cmp -s "$file" "$log_dir/orig"; then
+    echo "mutation-check: $name: the substitution did not apply to $file (the code moved?)" >&2
+    git checkout -- "$file"; exit 2
+  fi
+}
+
 if [ "${1:-}" = "--sample" ]; then
   shift
   want=("$@")
@@ -78,13 +92,7 @@ if [ "${1:-}" = "--sample" ]; then
   for m in "${sample[@]}"; do
     IFS='|' read -r name file subst target spec <<< "$m"
     if [ ${#want[@]} -gt 0 ] && [[ ! " ${want[*]} " == *" $name "* ]]; then continue; fi
-    git diff --quiet -- "$file" || { echo "mutation-check: $file has local changes: commit or stash them" >&2; exit 2; }
-    cp "$file" "$log_dir/orig"
-    perl -0pi -e "$subst" "$file"
-    if cmp -s "$file" "$log_dir/orig"; then
-      echo "mutation-check: $name: the substitution did not apply to $file (the code moved?)" >&2
-      git checkout -- "$file"; exit 2
-    fi
+    plant "$name" "$file" "$subst"
     echo "== $name ($file; $target \"$spec\")"
     git diff -U0 -- "$file" | grep '^[-+][^-+]' | sed 's/^/   /'
     if ! cmake --build build -j "$(nproc)" --target "$target" > "$log_dir/$name.build.log" 2>&1; then
@@ -112,13 +120,7 @@ survived=0
 for m in "${mutations[@]}"; do
   IFS='|' read -r name file subst <<< "$m"
   if [ ${#want[@]} -gt 0 ] && [[ ! " ${want[*]} " == *" $name "* ]]; then continue; fi
-  git diff --quiet -- "$file" || { echo "mutation-check: $file has local changes: commit or stash them" >&2; exit 2; }
-  cp "$file" "$log_dir/orig"
-  perl -0pi -e "$subst" "$file"
-  if cmp -s "$file" "$log_dir/orig"; then
-    echo "mutation-check: $name: the substitution did not apply to $file (the code moved?)" >&2
-    git checkout -- "$file"; exit 2
-  fi
+  plant "$name" "$file" "$subst"
   echo "== $name ($file)"
   git diff -U0 -- "$file" | grep '^[-+][^-+]' | sed 's/^/   /'
   start=$(date +%s)
