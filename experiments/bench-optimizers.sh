@@ -2,7 +2,7 @@
 # Time against error of the search's optimizers, of the number of restarts and
 # of the non-greedy options on W1 (bluepaint, wiwo, grid 16, texture 16, 2
 # textures): one JSON line each (bench search) into OUT.jsonl, then the table
-# and plot of experiments/plot_time_error.py (OUT.png, x = process CPU seconds).
+# and plot of experiments/report/plot_time_error.py (OUT.png, x = process CPU seconds).
 # Usage: experiments/bench-optimizers.sh [path/to/brdf-factor] [OUT.jsonl] [all|optimizers|restarts|nongreedy]
 set -euo pipefail
 BF=${1:-./build/experiments/brdf-factor}

@@ -1,9 +1,9 @@
-// libFuzzer target: the experiment config parser (experiments/config.h
+// libFuzzer target: the experiment config parser (experiments/plan/plan.h
 // parse_plan: TOML, validation, sweep expansion) on text, no file needed.
 #include <exception>
 #include <string>
 
-#include "experiments/config.h"
+#include "experiments/config/config.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string text(reinterpret_cast<const char*>(data), size);

@@ -1,5 +1,5 @@
 // libFuzzer target: a shard's manifest.json as `merge` reads it
-// (experiments/outputs.h read_experiment_manifest, then merge_experiments
+// (experiments/report/outputs.h read_experiment_manifest, then merge_experiments
 // into a fresh folder). Oracle beyond crashes: every run id the reader
 // accepts is a plain name, and the merge writes nothing outside its folders
 // (a marker file next to them must survive).
@@ -12,8 +12,8 @@
 #include <sstream>
 
 #include "brdfs/safe_path.h"
-#include "experiments/outputs.h"
-#include "experiments/runner.h"
+#include "experiments/report/outputs.h"
+#include "experiments/run/runner.h"
 
 namespace fs = std::filesystem;
 

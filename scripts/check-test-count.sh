@@ -5,7 +5,7 @@
 # equal the names `ctest -N -LE 'slow|python|docs'` registers, one for one (the
 # Python module's pytest suite is one CTest entry labelled python, not a
 # Catch test; pytest itself fails on "no tests ran"; the quick-figures check
-# of the docs is one entry labelled docs). A TEST_CASE name
+# of the docs and the include-layer check are entries labelled docs). A TEST_CASE name
 # that catch_discover_tests splits (a ';' in it), a hidden test selected, or a
 # test executable not registered makes the lists differ and this script fail.
 #   scripts/check-test-count.sh [BUILD_DIR]     (default: build)

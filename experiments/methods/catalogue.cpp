@@ -3,7 +3,7 @@
 #include <mutex>
 #include <sstream>
 
-#include "experiments/cli_util.h"
+#include "experiments/common/cli_util.h"
 #include "experiments/methods/method_kind.h"
 #include "factor/export.h"
 

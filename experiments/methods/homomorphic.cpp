@@ -5,7 +5,7 @@
 #include <chrono>
 #include <cmath>
 
-#include "experiments/cli_util.h"
+#include "experiments/common/cli_util.h"
 #include "factor/export.h"
 #include "factor/refine.h"
 

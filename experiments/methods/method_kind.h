@@ -24,10 +24,10 @@
 #include <vector>
 
 #include "brdfs/sampleset.h"
-#include "experiments/config.h"
-#include "experiments/config_reader.h"
-#include "experiments/outputs.h"
-#include "experiments/render.h"
+#include "experiments/plan/plan.h"
+#include "experiments/plan/config_reader.h"
+#include "experiments/report/outputs.h"
+#include "experiments/report/render.h"
 #include "factor/isotropy.h"
 #include "factor/metrics.h"
 #include "factor/size_choice.h"
@@ -110,7 +110,7 @@ class MethodKind {
   }
   // Bytes export_files writes beyond the common estimate (textures of
   // texture_size per term, factorization.json): the preflight's disk estimate
-  // (experiments/preflight.h).
+  // (experiments/run/preflight.h).
   virtual uint64_t export_bytes(const MethodVariant& m) const {
     (void)m;
     return 0;

@@ -4,7 +4,7 @@
 // and its formula with the fitted parameters as runs/<id>/model.glsl.
 #include <algorithm>
 
-#include "experiments/cli_util.h"
+#include "experiments/common/cli_util.h"
 #include "experiments/methods/method_kind.h"
 #include "factor/export.h"
 #include "factor/model_fit.h"

@@ -2,7 +2,7 @@
 // own grid or quadrature nodes, so for measured data off its interpolant.
 #pragma once
 
-#include "experiments/cli_util.h"
+#include "experiments/common/cli_util.h"
 #include "experiments/methods/method_kind.h"
 
 namespace bf {

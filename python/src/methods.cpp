@@ -1,10 +1,10 @@
 // Every method kind in Python: mccool, fit, search, svd, sh_k, sh_r,
 // model_fit, and refine. A call's keyword options become the [[method]] table
 // a config would hold and are read by the config reader's code for that table
-// (experiments/config_reader.h read_method_table, the kinds of
+// (experiments/plan/config_reader.h read_method_table, the kinds of
 // experiments/methods/): keys, defaults, ranges, rules and error messages live
 // there once. The call then runs the kind as the runner runs one run
-// (experiments/runner.cpp execute_run: MethodKind::run), in a LongCall (GIL
+// (experiments/run/runner.cpp execute_run: MethodKind::run), in a LongCall (GIL
 // released, Ctrl-C cancels), and reports metrics on the samples like a
 // results row.
 #include <algorithm>
@@ -13,8 +13,8 @@
 #include <toml++/toml.h>
 
 #include "common.h"
-#include "experiments/cli_util.h"
-#include "experiments/config_reader.h"
+#include "experiments/common/cli_util.h"
+#include "experiments/config/config.h"
 #include "experiments/methods/homomorphic.h"
 #include "experiments/methods/method_kind.h"
 #include "factor/isotropy.h"

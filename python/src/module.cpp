@@ -6,8 +6,8 @@
 
 #include "brdfs/catalogue.h"
 #include "common.h"
-#include "experiments/config.h"
-#include "experiments/interrupt.h"
+#include "experiments/plan/plan.h"
+#include "experiments/run/interrupt.h"
 #include "factor/export.h"
 #include "solvers/cancel.h"
 

@@ -1,10 +1,10 @@
 // Experiment configs from Python: brdf_factor._core.run_experiment wraps
-// bf::run_experiment (experiments/runner.h) exactly as `brdf-factor run` calls it.
+// bf::run_experiment (experiments/run/runner.h) exactly as `brdf-factor run` calls it.
 #include <iostream>
 #include <sstream>
 
 #include "common.h"
-#include "experiments/runner.h"
+#include "experiments/run/runner.h"
 
 namespace bf::py_module {
 

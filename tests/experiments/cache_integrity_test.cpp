@@ -14,8 +14,8 @@
 #include <map>
 #include <nlohmann/json.hpp>
 
-#include "experiments/config.h"
-#include "experiments/outputs.h"
+#include "experiments/plan/plan.h"
+#include "experiments/report/outputs.h"
 #include "experiments_helpers.h"
 #include "process_helpers.h"
 

@@ -1,7 +1,7 @@
 // Config parsing, validation messages, sweep expansion and -D overrides.
 #include <algorithm>
 
-#include "experiments/config.h"
+#include "experiments/config/config.h"
 #include "experiments/methods/method_kind.h"
 #include "experiments_helpers.h"
 

@@ -10,8 +10,8 @@
 #include <cstring>
 #include <nlohmann/json.hpp>
 
-#include "experiments/escape.h"
-#include "experiments/outputs.h"
+#include "experiments/report/escape.h"
+#include "experiments/report/outputs.h"
 #include "experiments_helpers.h"
 
 using namespace bf;

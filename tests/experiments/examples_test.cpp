@@ -1,7 +1,7 @@
 // Every example config under experiments/ validates at full size and runs at
 // reduced size (through -D overrides, as a user would shrink it).
-#include "experiments/config.h"
-#include "experiments/outputs.h"
+#include "experiments/config/config.h"
+#include "experiments/report/outputs.h"
 #include "experiments_helpers.h"
 
 using namespace bf;

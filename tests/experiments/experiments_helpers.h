@@ -11,7 +11,8 @@
 #include <vector>
 
 #include "brdfs/catalogue.h"
-#include "experiments/runner.h"
+#include "experiments/config/config.h"
+#include "experiments/run/runner.h"
 #include "factor/export.h"
 #include "test_common.h"
 

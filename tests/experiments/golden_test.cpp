@@ -5,7 +5,7 @@
 // tests/data/golden/make-run-ids.sh only for a change meant to change run ids.
 #include <set>
 
-#include "experiments/runner.h"
+#include "experiments/run/runner.h"
 #include "experiments_helpers.h"
 
 using namespace bf;

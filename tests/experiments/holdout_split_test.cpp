@@ -1,4 +1,4 @@
-// The held-out split (experiments/validation.h split_holdout) as a sample:
+// The held-out split (experiments/report/validation.h split_holdout) as a sample:
 // over many seeds every valid sample, the first and the last included, is
 // held out about `fraction` of the time; masked samples never are; weights
 // follow their samples; held-out metrics use those weights.
@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "brdfs/sampleset.h"
-#include "experiments/validation.h"
+#include "experiments/report/validation.h"
 
 using namespace bf;
 

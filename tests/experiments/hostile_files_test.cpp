@@ -10,7 +10,7 @@
 #include <string>
 
 #include "brdfs/safe_path.h"
-#include "experiments/toml_depth.h"
+#include "experiments/plan/toml_depth.h"
 #include "experiments_helpers.h"
 #include "factor/metrics.h"
 #include "process_helpers.h"

@@ -15,8 +15,8 @@
 #include <regex>
 #include <thread>
 
-#include "experiments/config.h"
-#include "experiments/preflight.h"
+#include "experiments/config/config.h"
+#include "experiments/run/preflight.h"
 #include "experiments_helpers.h"
 
 using namespace bf;

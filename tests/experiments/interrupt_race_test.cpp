@@ -1,12 +1,12 @@
 // A run that finishes while the runner is handling SIGINT: the tables and the
 // run folders must agree (docs/robustness.md "Interrupt race"). The race is
 // made deterministic with the runner's test hook BF_TEST_SIGNAL_AT_RUN_END
-// (experiments/interrupt.h): the first run to finish raises SIGINT itself
+// (experiments/run/interrupt.h): the first run to finish raises SIGINT itself
 // just before its DONE marker and waits until the runner has taken its list of
 // finished runs, so the run ends exactly while the signal is being handled.
 #include <catch2/catch.hpp>
 
-#include "experiments/outputs.h"
+#include "experiments/report/outputs.h"
 #include "experiments_helpers.h"
 #include "process_helpers.h"
 

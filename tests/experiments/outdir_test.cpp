@@ -13,8 +13,8 @@
 #include <thread>
 
 #include "brdfs/temp_file.h"
-#include "experiments/config.h"
-#include "experiments/outdir_lock.h"
+#include "experiments/config/config.h"
+#include "experiments/run/outdir_lock.h"
 #include "experiments_helpers.h"
 #include "process_helpers.h"
 

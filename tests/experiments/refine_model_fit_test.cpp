@@ -4,8 +4,8 @@
 #include <cmath>
 #include <nlohmann/json.hpp>
 
-#include "experiments/config.h"
-#include "experiments/outputs.h"
+#include "experiments/config/config.h"
+#include "experiments/report/outputs.h"
 #include "factor/metrics.h"
 #include "factor/model_fit.h"
 #include "factor/model_glsl.h"

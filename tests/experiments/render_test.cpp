@@ -2,7 +2,7 @@
 #include "factor/image_io.h"
 
 #include "brdfs/catalogue.h"
-#include "experiments/render.h"
+#include "experiments/report/render.h"
 #include "experiments_helpers.h"
 
 using namespace bf;

@@ -6,8 +6,8 @@
 #include <fstream>
 #include <thread>
 
-#include "experiments/outputs.h"
-#include "experiments/report.h"
+#include "experiments/report/outputs.h"
+#include "experiments/report/report.h"
 #include "test_common.h"
 
 using namespace bf;

@@ -5,7 +5,7 @@
 // is done must not (or every cached run would be redone for nothing).
 #include <catch2/catch.hpp>
 
-#include "experiments/config.h"
+#include "experiments/config/config.h"
 #include "experiments_helpers.h"
 
 using namespace bf_test;

@@ -4,8 +4,8 @@
 #include <nlohmann/json.hpp>
 #include <regex>
 
-#include "experiments/outputs.h"
-#include "experiments/report.h"
+#include "experiments/report/outputs.h"
+#include "experiments/report/report.h"
 #include "experiments_helpers.h"
 
 using namespace bf;

@@ -6,7 +6,7 @@
 #include <map>
 #include <set>
 
-#include "experiments/outputs.h"
+#include "experiments/report/outputs.h"
 #include "experiments_helpers.h"
 #include "factor/export.h"
 

@@ -4,7 +4,7 @@
 // search at the first term that reaches the target.
 #include <algorithm>
 
-#include "experiments/config.h"
+#include "experiments/config/config.h"
 #include "experiments_helpers.h"
 
 using namespace bf;

@@ -1,10 +1,10 @@
 // Pages regenerated from unchanged inputs are not rewritten: a cached re-run
 // leaves report.html and results.md (bytes and mtime) as they were; a change
 // that shows on the page rewrites them. (The plots skip by hash in
-// experiments/plot_results.py.)
+// experiments/report/plot_results.py.)
 #include <chrono>
 
-#include "experiments/cli_util.h"
+#include "experiments/common/cli_util.h"
 #include "experiments_helpers.h"
 
 using namespace bf;

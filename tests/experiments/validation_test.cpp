@@ -1,4 +1,4 @@
-// Validation on data the fit never saw (experiments/validation.h): held-out
+// Validation on data the fit never saw (experiments/report/validation.h): held-out
 // samples, the whole-domain set, the default scene's shade_rmse, tolerances
 // on shade_rmse, and the flags.
 #include <algorithm>
@@ -6,8 +6,8 @@
 
 #include "brdfs/catalogue.h"
 #include "brdfs/sample_csv.h"
-#include "experiments/config.h"
-#include "experiments/validation.h"
+#include "experiments/config/config.h"
+#include "experiments/report/validation.h"
 #include "factor/size_choice.h"
 #include "experiments_helpers.h"
 

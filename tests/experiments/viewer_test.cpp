@@ -12,8 +12,8 @@
 
 #include "brdfs/catalogue.h"
 #include "brdfs/directions.h"
-#include "experiments/config.h"
-#include "experiments/render.h"
+#include "experiments/config/config.h"
+#include "experiments/report/render.h"
 #include "experiments_helpers.h"
 
 using namespace bf;

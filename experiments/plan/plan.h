@@ -1,0 +1,171 @@
+// Experiment configs (docs/design.md §5, docs/experiments.md): TOML parsing, `-D`
+// overrides, validation that names file:line, field and rule for every problem
+// before any work starts, and sweep expansion into a plan of runs, each with a
+// content-hash run id.
+#pragma once
+
+#include <any>
+#include <cstdint>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "brdfs/brdf.h"
+#include "factor/homomorphic_fit.h"
+#include "factor/lighting.h"
+#include "factor/model_fit.h"
+#include "factor/refine.h"
+#include "factor/sh_baseline.h"
+#include "factor/svd_baseline.h"
+#include "search/term_search.h"
+
+namespace bf {
+
+class MethodKind;  // experiments/methods/method_kind.h
+
+// Every problem found in a config, one line each, formatted
+// "<file>:<line>: <field>: <rule, expected, found>" (or "-D key=value: <field>: ..."
+// for a value given on the command line). what() joins them so that main()'s
+// "brdf-factor: " prefix starts every line.
+class ConfigError : public std::invalid_argument {
+ public:
+  explicit ConfigError(std::vector<std::string> messages);
+  const std::vector<std::string>& messages() const { return messages_; }
+
+ private:
+  std::vector<std::string> messages_;
+};
+
+// [experiment]
+struct ExperimentSettings {
+  std::string name;         // default: the config file's stem
+  uint64_t seed = 1;        // default seed of stratified sampling and of searches
+  std::string out;          // output folder; default "results/<name>" (relative to the working dir)
+  std::string description;  // free text shown in results.md and report.html
+  int jobs = 0;             // runs executed at once; 0 = hardware threads (see runner.h)
+  bool plots = true;        // call experiments/report/plot_results.py after the runs
+  bool render = true;       // per run: sphere picture (original | approximation | error)
+  bool export_factors = true;  // per run: factor textures, sidecar, GLSL (config key `export`)
+  double metric_eps = 1e-5; // eps of the log transform every method is scored with (docs/design.md §4)
+  // Validation (docs/design.md §4 "validation"): stratified pairs over the
+  // whole hemisphere pair scored against the BRDF (0 = none), and the
+  // fraction of measured/file samples held out of the fit.
+  int validation_pairs = 4096;
+  double holdout = 0.1;
+};
+
+// The seed of the validation set and of the held-out choice, derived from
+// experiment.seed (independent of every sampling and method seed).
+uint64_t validation_seed(uint64_t experiment_seed);
+
+// [scene]: the picture of every run and the shade_rmse column (docs/design.md
+// §4), with the defaults below when the config has no [scene] (the default
+// scene); `shade_rmse = false` drops the column. A unit sphere at the origin seen by an
+// orthographic camera on +z, lit by one point light, or by band-limited SH
+// lighting (factor/lighting.h) when `environment` or `lighting_order` is set;
+// the SH lighting's order then caps the orders of sh-k and sh-r.
+struct SceneSettings {
+  bool named = false;             // the config has a [scene] table
+  bool shade = true;              // key shade_rmse: the shade_rmse column (default scene when no [scene])
+  Vec3 light = Vec3(2.0, 2.0, 4.0);  // light position (world; sphere radius 1)
+  double intensity = 20.0;        // radiance = intensity * f * cos(theta_i) / distance^2
+  int size = 128;                 // pixels per panel edge
+  std::string environment;        // lat-long map (resolved path); "" = none
+  double environment_eps = 1e-3;  // band limit: smallest L capturing 1 - eps of the map's energy
+  int lighting_order = -1;        // explicit band limit (-1: measured, or point light without a map)
+  int lighting_nodes = 0;         // shading quadrature: theta nodes (0 = auto), phi = 2x
+  std::shared_ptr<const ShLighting> lighting;  // set when the scene is SH-lit
+  nlohmann::json identity() const;
+};
+
+struct BrdfVariant {
+  std::string label;        // the results' `brdf` column: `name`, else "preset[:k=v,...]" or the file
+  std::string where;        // "file:line" of its [[brdf]] table
+  BrdfPtr brdf;
+  bool measured = false;    // has raw measured samples (sampling.kind = "measured")
+  nlohmann::json identity;  // everything that determines it (hashed into run ids)
+};
+
+struct SamplingVariant {
+  std::string kind;         // "grid" | "stratified" | "file" | "measured"
+  int resolution = 16;      // grid: res^4 parabolic grid
+  uint64_t count = 0;       // stratified: pairs
+  uint64_t seed = 1;        // stratified
+  std::string path;         // file: sample-list CSV (resolved path)
+  std::string label;        // "grid 16^4", "stratified 20000 seed 1", "file x.csv", "measured"
+  std::string where;
+  nlohmann::json identity;  // kind + parameters (+ file digest)
+};
+
+// One [[method]] variant. Its kind (experiments/methods/) reads and runs it;
+// only the kind looks at its typed options.
+struct MethodVariant {
+  std::string kind;         // a registered kind's name (`brdf-factor list methods`)
+  const MethodKind* impl = nullptr;  // that kind
+
+  std::string label;        // `label` key, default the kind
+  std::string where;        // "file:line" of its [[method]] table
+  nlohmann::json options;   // every effective option with its default filled in (hashed)
+  nlohmann::json execution; // options that do not change results (threads): recorded, not hashed
+  // Typed options, filled by the kind's reader (those of the kind are
+  // meaningful). A kind with options of its own type keeps them in `extra`.
+  int texture_size = 16;
+  int terms = 2;
+  Parameterization param = Parameterization::WiWo;
+  bool reciprocity = false;
+  FitOptions fit;                    // mccool, fit, search (search.fit mirrors it)
+  std::vector<TermSpec> projections; // fit: all configured projections at texture_size
+  SearchOptions search;
+  SvdOptions svd;
+  ShkOptions shk;
+  ShrOptions shr;
+  bool shrm = false;                 // sh-r: also the SHRM under the scene's SH lighting
+  std::optional<Tolerance> tolerance;  // fit, svd, sh-k, sh-r
+  // mccool, fit, search: "none" | "linear" | "cosine" | "blend" (factor/refine.h),
+  // the refinement stage run after the fit (refine_blend, refine_iterations,
+  // refine_smoothing fill refine_options).
+  std::string refine = "none";
+  RefineOptions refine_options;
+  ModelFitOptions model_fit;           // model-fit
+  int cap = 0;              // with a tolerance: the largest terms / order tried
+  // texture_size = "auto" (mccool, fit, svd; needs a tolerance): the
+  // resolutions tried, ascending (key texture_ladder); empty = fixed texture_size.
+  std::vector<int> texture_ladder;
+  uint64_t seed = 0;        // search seed (0 when the kind has none)
+  int cores = 1;            // cores the method keeps busy by itself (scheduling, runner.h)
+  std::any extra;           // options of a kind that has no field above
+};
+
+struct PlannedRun {
+  std::string run_id;       // 12 hex digits of the identity's hash
+  size_t brdf = 0, sampling = 0, method = 0;  // indices into Plan's vectors
+  std::string samples_key;  // hash of (brdf, sampling) identities: the sample cache key
+  nlohmann::json identity;  // everything that determines the run's outputs
+};
+
+struct Plan {
+  std::string config_path;  // as given
+  std::string config_text;  // the file as read
+  std::vector<std::string> defines;  // -D key=value, in order
+  ExperimentSettings experiment;
+  SceneSettings scene;
+  std::vector<BrdfVariant> brdfs;
+  std::vector<SamplingVariant> samplings;
+  std::vector<MethodVariant> methods;
+  // Product brdfs x samplings x methods, in that nesting order; combinations
+  // with an identical identity are kept once (counted in `duplicates`).
+  std::vector<PlannedRun> runs;
+  size_t duplicates = 0;
+  std::string plan_hash;    // hash of every run id in order (shards of one plan share it)
+};
+
+// 64-bit FNV-1a of bytes as 16 hex digits.
+std::string content_hash(const std::string& bytes);
+// FNV-1a of a file's bytes (16 hex digits); throws std::invalid_argument if unreadable.
+std::string file_hash(const std::string& path);
+// 12 hex digits of content_hash(j.dump()) (nlohmann orders object keys, so equal values hash equally).
+std::string short_hash(const nlohmann::json& j);
+
+}  // namespace bf

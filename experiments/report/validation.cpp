@@ -1,0 +1,123 @@
+// Validation sets, held-out samples and flags (see validation.h).
+#include "experiments/report/validation.h"
+
+#include <cmath>
+#include <stdexcept>
+
+namespace bf {
+
+namespace {
+
+// SplitMix64: a portable generator (std::shuffle's algorithm is unspecified).
+uint64_t splitmix(uint64_t& x) {
+  uint64_t z = (x += 0x9e3779b97f4a7c15ULL);
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+  return z ^ (z >> 31);
+}
+
+}  // namespace
+
+bool holds_out(const SamplingVariant& s, const ExperimentSettings& e) {
+  return e.holdout > 0.0 && (s.kind == "measured" || s.kind == "file");
+}
+
+HoldoutSplit split_holdout(const SampleSet& s, double fraction, uint64_t seed) {
+  if (!(fraction >= 0.0 && fraction <= 0.5))
+    throw std::invalid_argument("holdout: expected a fraction in 0..0.5, found " + std::to_string(fraction));
+  std::vector<size_t> valid;
+  for (size_t k = 0; k < s.size(); ++k)
+    if (s.valid[k]) valid.push_back(k);
+  const size_t n_held = static_cast<size_t>(std::llround(fraction * static_cast<double>(valid.size())));
+  if (valid.size() - n_held < 2)
+    throw std::invalid_argument("holdout: " + std::to_string(valid.size()) + " valid samples leave " +
+                                std::to_string(valid.size() - n_held) +
+                                " to fit after holding out " + std::to_string(n_held) + "; expected at least 2");
+  // Partial Fisher-Yates: the first n_held entries are the held-out samples.
+  uint64_t state = seed;
+  for (size_t i = 0; i < n_held; ++i) {
+    const size_t j = i + static_cast<size_t>(splitmix(state) % (valid.size() - i));
+    std::swap(valid[i], valid[j]);
+  }
+  std::vector<uint8_t> is_held(s.size(), 0);
+  for (size_t i = 0; i < n_held; ++i) is_held[valid[i]] = 1;
+  HoldoutSplit out;
+  const bool weighted = !s.weight.empty();
+  for (size_t k = 0; k < s.size(); ++k) {
+    SampleSet& dst = is_held[k] ? out.held : out.train;
+    dst.wi.push_back(s.wi[k]);
+    dst.wo.push_back(s.wo[k]);
+    dst.value.push_back(s.value[k]);
+    dst.valid.push_back(s.valid[k]);
+    if (weighted) dst.weight.push_back(s.weight[k]);
+  }
+  out.train.invalid_value = s.invalid_value;
+  out.train.invalid_horizon = s.invalid_horizon;
+  out.train.invalid_weight = s.invalid_weight;
+  out.train.description = s.description + " without " + std::to_string(n_held) + " held-out samples";
+  out.held.description = std::to_string(n_held) + " held-out samples of " + s.description;
+  return out;
+}
+
+SampleSet validation_set(const Brdf& brdf, int pairs, uint64_t seed) {
+  SampleSet v = sample_stratified(brdf, static_cast<size_t>(pairs), seed);
+  v.description = "validation: stratified " + std::to_string(pairs) + " pairs over the hemisphere pair";
+  return v;
+}
+
+ValidationScores score_validation(const Brdf& approx, const SampleSet* domain, const SampleSet* held,
+                                  const LogTransform& lt) {
+  ValidationScores v;
+  if (domain && domain->valid_count() > 0) {
+    v.domain = true;
+    v.val = evaluate_metrics(approx, *domain, lt);
+    v.max_ratio = peak_ratio(approx, *domain);
+  }
+  if (held && held->valid_count() > 0) {
+    v.holdout = true;
+    v.held = evaluate_metrics(approx, *held, lt);
+  }
+  return v;
+}
+
+void fill_validation_columns(const ValidationScores& v, double training_rel_mse, const std::string& scheme,
+                             Row& row, std::vector<std::string>& notes) {
+  std::vector<std::string> flags;
+  auto far_above = [&](double e) {
+    return e > kFlagErrorFactor * training_rel_mse && e > kFlagErrorFloor;
+  };
+  auto flag_error = [&](const char* col, double e) {
+    if (!far_above(e)) return;
+    flags.push_back(col);
+    notes.push_back(std::string("flag: ") + col + " " + format_short(format_number(e)) + " is " +
+                    (training_rel_mse > 0 ? format_short(format_number(e / training_rel_mse)) + "x"
+                                          : std::string("far above")) +
+                    " the training rel_mse " + format_short(format_number(training_rel_mse)) + " (threshold " +
+                    format_short(format_number(kFlagErrorFactor)) + "x and " +
+                    format_short(format_number(kFlagErrorFloor)) + "): the fit does not generalize");
+  };
+  if (v.domain) {
+    row["val_rel_mse"] = format_number(v.val.rel_mse);
+    row["val_cos_rmse"] = format_number(v.val.cos_rmse);
+    row["val_max_ratio"] = format_number(v.max_ratio);
+    flag_error("val_rel_mse", v.val.rel_mse);
+    if (v.max_ratio > kFlagMaxRatio) {
+      flags.push_back("val_max_ratio");
+      notes.push_back("flag: val_max_ratio " + format_short(format_number(v.max_ratio)) + " > " +
+                      format_short(format_number(kFlagMaxRatio)) +
+                      ": somewhere in the domain the approximation exceeds the BRDF's peak that many times "
+                      "(extrapolation where no sample constrains it)");
+    }
+  }
+  if (v.holdout) {
+    row["holdout_rel_mse"] = format_number(v.held.rel_mse);
+    row["holdout_cos_rmse"] = format_number(v.held.cos_rmse);
+    flag_error("holdout_rel_mse", v.held.rel_mse);
+  }
+  row["validation"] = scheme;
+  std::string f;
+  for (const auto& x : flags) f += (f.empty() ? "" : ",") + x;
+  row["flag"] = f;
+}
+
+}  // namespace bf
