@@ -1,6 +1,6 @@
 // The error an options struct's validate() throws: an std::invalid_argument
 // that also carries the option's name, so that a caller reading the options
-// from a file (experiments/config.cpp) reports the problem at that key's
+// from a file (experiments/config/config.cpp) reports the problem at that key's
 // file:line. what() is the full message, "<field>: <rule>, found <value>".
 #pragma once
 
