@@ -554,89 +554,84 @@ class DataFile {
 
 }  // namespace
 
-bool is_baseline_method(const std::string& method) {
-  return method == "svd" || method == "sh-k" || method == "sh-r";
-}
+namespace {
 
-std::string generate_baseline_glsl(const Factorization& f, const std::string& stem) {
-  if (auto s = dynamic_cast<const SvdFactorization*>(&f)) return svd_glsl(*s, stem);
-  if (auto s = dynamic_cast<const ShkFactorization*>(&f)) return shk_glsl(*s, stem);
-  if (auto s = dynamic_cast<const ShrFactorization*>(&f))
-    return shr_glsl(*s, f.describe().at("min_cos").get<double>());
-  throw std::invalid_argument("export: method '" + f.method() + "' has no SVD/SH export");
-}
-
-std::vector<std::pair<std::string, FloatImage>> baseline_textures(const Factorization& f) {
-  std::vector<std::pair<std::string, FloatImage>> out;
-  DataBlocks d;
-  if (auto s = dynamic_cast<const SvdFactorization*>(&f)) {
-    FloatImage rows, cols;
-    svd_data(*s, d, rows, cols);
-    out.emplace_back("brdf_factor_rows", std::move(rows));
-    out.emplace_back("brdf_factor_cols", std::move(cols));
-  } else if (auto s = dynamic_cast<const ShkFactorization*>(&f)) {
-    FloatImage img;
-    shk_data(*s, d, img);
-    out.emplace_back("brdf_factor_coeffs", std::move(img));
-  } else if (!dynamic_cast<const ShrFactorization*>(&f)) {
-    throw std::invalid_argument("export: method '" + f.method() + "' has no SVD/SH export");
-  }
-  return out;
-}
-
-BaselineExportFiles write_baseline_export(const Factorization& f, const std::string& dir,
-                                          const std::string& stem) {
-  if (stem.empty() || stem.find('/') != std::string::npos)
-    throw std::invalid_argument("export: stem: expected a non-empty name without '/', found \"" + stem + "\"");
-  json j = f.describe();
+// The parts of an SVD / SH export before it is written: the sidecar (the
+// result's describe() plus the method's fields), the data blocks, the EXR
+// images (file name, image) and their sidecar entries.
+struct BaselineParts {
+  json j;
   DataBlocks d;
   std::vector<std::pair<std::string, FloatImage>> images;
   json textures = json::array();
-  if (auto s = dynamic_cast<const SvdFactorization*>(&f)) {
-    FloatImage rows, cols;
-    svd_data(*s, d, rows, cols);
-    const int K = s->rank(), R = s->grid().res;
-    const std::string layout = std::to_string(K * R) + "x" + std::to_string(R) +
-                               " float32 RGB: term k's factor texel (i, j) at pixel (k * resolution + i, j), "
-                               "scanline 0 first; 0 outside the mask";
-    textures.push_back({{"file", stem + "_rows.exr"}, {"sampler", "brdf_factor_rows"}, {"binding", 0},
-                        {"holds", "u (row factors)"}, {"layout", layout}});
-    textures.push_back({{"file", stem + "_cols.exr"}, {"sampler", "brdf_factor_cols"}, {"binding", 1},
-                        {"holds", "v (column factors)"}, {"layout", layout}});
-    images.emplace_back(stem + "_rows.exr", std::move(rows));
-    images.emplace_back(stem + "_cols.exr", std::move(cols));
-    j["texel_mapping"] =
-        "s_row = (x[0..1] + 1) / 2 * (resolution - 1), s_col = (x[2..3] + 1) / 2 * (resolution - 1), x = "
-        "(p(wi), p(wo)) or (p(h), p(d)); bilinear as docs/design.md §2.6";
-  } else if (auto s = dynamic_cast<const ShkFactorization*>(&f)) {
-    FloatImage img;
-    shk_data(*s, d, img);
-    const int N = sh_count(s->order()), R = s->grid().res, T = shk_tiles_per_row(N);
-    j["tiles_per_row"] = T;
-    textures.push_back(
-        {{"file", stem + "_coeffs.exr"}, {"sampler", "brdf_factor_coeffs"}, {"binding", 0},
-         {"holds", "SH coefficients c_i"},
-         {"layout", s->options().reduced
-                        ? std::to_string(R) + "x" + std::to_string(N) +
-                              " float32 RGB: pixel (j, i) = coefficient i at view radius j/(R-1), azimuth 0"
-                        : std::to_string(img.width) + "x" + std::to_string(img.height) +
-                              " float32 RGB: coefficient i is the R x R tile at pixel ((i % tiles_per_row) * R, "
-                              "(i / tiles_per_row) * R); view texel (k, j) at tile pixel (k, j); 0 outside "
-                              "the mask"}});
-    images.emplace_back(stem + "_coeffs.exr", std::move(img));
-  } else if (auto s = dynamic_cast<const ShrFactorization*>(&f)) {
-    std::vector<double> all;
-    for (int c = 0; c < 3; ++c) {
-      const auto v = shr_rho(*s, c);
-      all.insert(all.end(), v.begin(), v.end());
-    }
-    d.add("rho", {3, shr_coefficient_count(s->order(), s->view_order())},
-          "rho[c][n], n running over q = 0..min(F, P), then l = q..F, then p = q..P (p fastest)", all);
-  } else {
-    throw std::invalid_argument("export: method '" + f.method() + "' has no SVD/SH export");
-  }
-  const std::string glsl = generate_baseline_glsl(f, stem);
+};
 
+void check_stem(const std::string& stem) {
+  if (stem.empty() || stem.find('/') != std::string::npos)
+    throw std::invalid_argument("export: stem: expected a non-empty name without '/', found \"" + stem + "\"");
+}
+
+BaselineParts parts_of(const SvdFactorization& s, const std::string& stem) {
+  BaselineParts p;
+  p.j = s.describe();
+  FloatImage rows, cols;
+  svd_data(s, p.d, rows, cols);
+  const int K = s.rank(), R = s.grid().res;
+  const std::string layout = std::to_string(K * R) + "x" + std::to_string(R) +
+                             " float32 RGB: term k's factor texel (i, j) at pixel (k * resolution + i, j), "
+                             "scanline 0 first; 0 outside the mask";
+  p.textures.push_back({{"file", stem + "_rows.exr"}, {"sampler", "brdf_factor_rows"}, {"binding", 0},
+                        {"holds", "u (row factors)"}, {"layout", layout}});
+  p.textures.push_back({{"file", stem + "_cols.exr"}, {"sampler", "brdf_factor_cols"}, {"binding", 1},
+                        {"holds", "v (column factors)"}, {"layout", layout}});
+  p.images.emplace_back(stem + "_rows.exr", std::move(rows));
+  p.images.emplace_back(stem + "_cols.exr", std::move(cols));
+  p.j["texel_mapping"] =
+      "s_row = (x[0..1] + 1) / 2 * (resolution - 1), s_col = (x[2..3] + 1) / 2 * (resolution - 1), x = "
+      "(p(wi), p(wo)) or (p(h), p(d)); bilinear as docs/design.md §2.6";
+  return p;
+}
+
+BaselineParts parts_of(const ShkFactorization& s, const std::string& stem) {
+  BaselineParts p;
+  p.j = s.describe();
+  FloatImage img;
+  shk_data(s, p.d, img);
+  const int N = sh_count(s.order()), R = s.grid().res, T = shk_tiles_per_row(N);
+  p.j["tiles_per_row"] = T;
+  p.textures.push_back(
+      {{"file", stem + "_coeffs.exr"}, {"sampler", "brdf_factor_coeffs"}, {"binding", 0},
+       {"holds", "SH coefficients c_i"},
+       {"layout", s.options().reduced
+                      ? std::to_string(R) + "x" + std::to_string(N) +
+                            " float32 RGB: pixel (j, i) = coefficient i at view radius j/(R-1), azimuth 0"
+                      : std::to_string(img.width) + "x" + std::to_string(img.height) +
+                            " float32 RGB: coefficient i is the R x R tile at pixel ((i % tiles_per_row) * R, "
+                            "(i / tiles_per_row) * R); view texel (k, j) at tile pixel (k, j); 0 outside "
+                            "the mask"}});
+  p.images.emplace_back(stem + "_coeffs.exr", std::move(img));
+  return p;
+}
+
+BaselineParts parts_of(const ShrFactorization& s, const std::string& stem) {
+  (void)stem;  // no textures
+  BaselineParts p;
+  p.j = s.describe();
+  std::vector<double> all;
+  for (int c = 0; c < 3; ++c) {
+    const auto v = shr_rho(s, c);
+    all.insert(all.end(), v.begin(), v.end());
+  }
+  p.d.add("rho", {3, shr_coefficient_count(s.order(), s.view_order())},
+          "rho[c][n], n running over q = 0..min(F, P), then l = q..F, then p = q..P (p fastest)", all);
+  return p;
+}
+
+// Writes the parts of f's export and its GLSL: STEM.f64, STEM_*.exr, STEM.glsl, STEM.json (last).
+ExportedFiles write_parts(const Factorization& f, BaselineParts p, const std::string& glsl, const std::string& dir,
+                          const std::string& stem) {
+  json& j = p.j;
+  const DataBlocks& d = p.d;
   j["format"] = kFactorExportFormat;
   j["format_version"] = kFactorExportFormatVersion;
   j["data"] = {{"file", stem + ".f64"},
@@ -644,21 +639,21 @@ BaselineExportFiles write_baseline_export(const Factorization& f, const std::str
                {"byte_order", "little-endian"},
                {"values", d.values.size()},
                {"blocks", d.blocks}};
-  j["textures"] = textures;
+  j["textures"] = p.textures;
   j["glsl"] = stem + ".glsl";
 
   const fs::path folder(dir);
   std::error_code ec;
   fs::create_directories(folder, ec);
   if (ec) throw std::runtime_error(dir + ": cannot create folder: " + ec.message());
-  BaselineExportFiles out;
+  ExportedFiles out;
   AtomicBatch batch(folder);
   {
     const fs::path tmp = batch.add(stem + ".f64");
     write_bytes(tmp, folder / (stem + ".f64"), d.values.data(), d.values.size() * sizeof(double));
     out.data = (folder / (stem + ".f64")).string();
   }
-  for (const auto& [name, img] : images) {
+  for (const auto& [name, img] : p.images) {
     write_exr(batch.add(name).string(), img, "brdf-factor " + f.method() + " export");
     out.textures.push_back((folder / name).string());
   }
@@ -669,6 +664,81 @@ BaselineExportFiles write_baseline_export(const Factorization& f, const std::str
   out.sidecar = (folder / (stem + ".json")).string();
   batch.commit();
   return out;
+}
+
+// The viewer's data of an SVD / SH result: its GLSL with stem "factors" (the
+// run's export) and the textures of that export, keyed by sampler name.
+ShaderView view_of(const Factorization& f, BaselineParts p, const json& samplers) {
+  ShaderView v;
+  v.glsl = f.glsl("factors", "");
+  for (size_t k = 0; k < p.images.size(); ++k)
+    v.textures.emplace_back(samplers[k].at("sampler").get<std::string>(), std::move(p.images[k].second));
+  return v;
+}
+
+}  // namespace
+
+// ---- The outputs of the SVD / SH results (factor/factorization.h).
+
+ExportedFiles SvdFactorization::write_export_files(const std::string& dir, const std::string& stem,
+                                                   const std::string& origin) const {
+  check_stem(stem);
+  BaselineParts p = parts_of(*this, stem);  // checks the values first
+  const std::string text = glsl(stem, origin);
+  return write_parts(*this, std::move(p), text, dir, stem);
+}
+std::string SvdFactorization::glsl(const std::string& stem, const std::string& origin) const {
+  (void)origin;
+  return svd_glsl(*this, stem);
+}
+std::optional<ShaderView> SvdFactorization::viewer_data() const {
+  BaselineParts p = parts_of(*this, "factors");
+  const json samplers = p.textures;
+  return view_of(*this, std::move(p), samplers);
+}
+
+ExportedFiles ShkFactorization::write_export_files(const std::string& dir, const std::string& stem,
+                                                   const std::string& origin) const {
+  check_stem(stem);
+  BaselineParts p = parts_of(*this, stem);  // checks the values first
+  const std::string text = glsl(stem, origin);
+  return write_parts(*this, std::move(p), text, dir, stem);
+}
+std::string ShkFactorization::glsl(const std::string& stem, const std::string& origin) const {
+  (void)origin;
+  return shk_glsl(*this, stem);
+}
+std::optional<ShaderView> ShkFactorization::viewer_data() const {
+  BaselineParts p = parts_of(*this, "factors");
+  const json samplers = p.textures;
+  return view_of(*this, std::move(p), samplers);
+}
+
+ExportedFiles ShrFactorization::write_export_files(const std::string& dir, const std::string& stem,
+                                                   const std::string& origin) const {
+  check_stem(stem);
+  BaselineParts p = parts_of(*this, stem);  // checks the values first
+  const std::string text = glsl(stem, origin);
+  return write_parts(*this, std::move(p), text, dir, stem);
+}
+std::string ShrFactorization::glsl(const std::string& stem, const std::string& origin) const {
+  (void)stem, (void)origin;  // no textures
+  return shr_glsl(*this, describe().at("min_cos").get<double>());
+}
+std::optional<ShaderView> ShrFactorization::viewer_data() const { return ShaderView{glsl("factors", ""), {}}; }
+
+// ---- The SVD / SH export as one API (tests, load-back).
+
+bool is_baseline_method(const std::string& method) {
+  return method == "svd" || method == "sh-k" || method == "sh-r";
+}
+
+BaselineExportFiles write_baseline_export(const Factorization& f, const std::string& dir,
+                                          const std::string& stem) {
+  if (!is_baseline_method(f.method()))
+    throw std::invalid_argument("export: method '" + f.method() + "' has no SVD/SH export");
+  const ExportedFiles e = f.write_export_files(dir, stem, "");
+  return {e.sidecar, e.data, e.glsl, e.textures};
 }
 
 std::string sidecar_method(const std::string& json_path) {

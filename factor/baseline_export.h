@@ -39,20 +39,14 @@ struct BaselineExportFiles {
 };
 
 // Writes the export of an SvdFactorization, ShkFactorization or
-// ShrFactorization. Throws std::invalid_argument for another kind or a
+// ShrFactorization (its write_export_files). Throws std::invalid_argument for another kind or a
 // non-finite value (naming it), std::runtime_error naming a path that cannot
 // be written.
 BaselineExportFiles write_baseline_export(const Factorization& f, const std::string& dir,
                                           const std::string& stem);
 
-// The GLSL alone (what write_baseline_export writes as STEM.glsl); texture
-// file names appear in its comments.
-std::string generate_baseline_glsl(const Factorization& f, const std::string& stem);
-
-// The float32 textures of the export with their GLSL sampler names, in
-// binding order (what STEM_*.exr hold): svd rows, cols; sh-k coeffs; none for sh-r.
-struct FloatImage;
-std::vector<std::pair<std::string, FloatImage>> baseline_textures(const Factorization& f);
+// The GLSL and textures of these results: Factorization::glsl() and
+// viewer_data() (factor/factorization.h), defined in baseline_export.cpp.
 
 // Reads an export back from its sidecar (the .f64 file relative to the
 // sidecar's folder). Validates format, version, method, every field read, the

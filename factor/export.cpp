@@ -490,35 +490,69 @@ std::shared_ptr<HomomorphicFactorization> load_factorization(const std::string& 
 
 ExportedFiles write_export(const Factorization& f, const std::string& dir, const std::string& stem,
                            const std::string& origin) {
-  if (const auto* h = dynamic_cast<const HomomorphicFactorization*>(&f)) return write_factorization(*h, dir, stem);
-  if (is_baseline_method(f.method())) {
-    const BaselineExportFiles b = write_baseline_export(f, dir, stem);
-    ExportedFiles e;
-    e.sidecar = b.sidecar;
-    e.glsl = b.glsl;
-    e.textures = b.textures;
-    e.data = b.data;
-    return e;
+  return f.write_export_files(dir, stem, origin);
+}
+
+// ---- The outputs of the homomorphic and model-fit results (factor/factorization.h).
+
+ExportedFiles HomomorphicFactorization::write_export_files(const std::string& dir, const std::string& stem,
+                                                           const std::string& origin) const {
+  (void)origin;  // the GLSL quotes the sidecar's name
+  return write_factorization(*this, dir, stem);
+}
+
+std::string HomomorphicFactorization::glsl(const std::string& stem, const std::string& origin) const {
+  std::vector<std::string> tex_names;
+  for (size_t k = 0; k < terms().size(); ++k) tex_names.push_back(stem + "_term" + std::to_string(k) + ".exr");
+  return generate_glsl(*this, tex_names, origin.empty() ? stem + ".json" : origin);
+}
+
+std::optional<ShaderView> HomomorphicFactorization::viewer_data() const {
+  ShaderView v;
+  v.glsl = generate_glsl(*this, {}, "report.html viewer");
+  for (size_t k = 0; k < terms().size(); ++k) {
+    const FactorTerm& t = terms()[k];
+    const int R = t.proj.res;
+    FloatImage img;  // the log texels, as the EXR holds them
+    img.width = img.height = R;
+    img.channel_names = {"R", "G", "B"};
+    img.pixels.assign(size_t(R) * R * 3, 0.0f);
+    for (size_t q = 0; q < size_t(R) * R; ++q)
+      if (t.mask[q])
+        for (int c = 0; c < 3; ++c) img.pixels[3 * q + c] = t.texels[c][q];
+    v.textures.emplace_back(glsl_sampler_name(k), std::move(img));
   }
-  if (const auto* mf = dynamic_cast<const ModelFitFactorization*>(&f)) {
-    if (stem.empty() || stem.find('/') != std::string::npos)
-      throw std::invalid_argument("export: stem must be a non-empty file name without '/', found \"" + stem + "\"");
-    std::error_code ec;
-    fs::create_directories(dir, ec);
-    if (ec) throw std::runtime_error(dir + ": cannot create folder: " + ec.message());
-    ExportedFiles e;
-    e.sidecar = (fs::path(dir) / (stem + ".json")).string();
-    // The GLSL first: a parameter it refuses (not a finite float) leaves no file.
-    const std::string glsl = generate_model_glsl(*mf->result().brdf, origin);
-    write_model_fit(mf->result(), e.sidecar);
-    e.glsl = (fs::path(dir) / (stem + ".glsl")).string();
-    AtomicBatch batch{fs::path(dir)};
-    write_text(batch.add(stem + ".glsl"), e.glsl, glsl);
-    batch.commit();
-    return e;
-  }
-  throw std::invalid_argument("export: method " + f.method() +
-                              " has no export (mccool, fit, search, svd, sh-k, sh-r and model-fit have)");
+  return v;
+}
+
+ExportedFiles ModelFitFactorization::write_export_files(const std::string& dir, const std::string& stem,
+                                                        const std::string& origin) const {
+  if (stem.empty() || stem.find('/') != std::string::npos)
+    throw std::invalid_argument("export: stem must be a non-empty file name without '/', found \"" + stem + "\"");
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec) throw std::runtime_error(dir + ": cannot create folder: " + ec.message());
+  ExportedFiles e;
+  e.sidecar = (fs::path(dir) / (stem + ".json")).string();
+  // The GLSL first: a parameter it refuses (not a finite float) leaves no file.
+  const std::string text = glsl(stem, origin);
+  write_model_fit(result(), e.sidecar);
+  e.glsl = (fs::path(dir) / (stem + ".glsl")).string();
+  AtomicBatch batch{fs::path(dir)};
+  write_text(batch.add(stem + ".glsl"), e.glsl, text);
+  batch.commit();
+  return e;
+}
+
+std::string ModelFitFactorization::glsl(const std::string& stem, const std::string& origin) const {
+  (void)stem;  // no texture files
+  return generate_model_glsl(*result().brdf, origin);
+}
+
+std::optional<ShaderView> ModelFitFactorization::viewer_data() const {
+  // The fitted model's formula (model.glsl), no textures; none for a model without generated GLSL.
+  if (!result().brdf || !has_model_glsl(*result().brdf)) return std::nullopt;
+  return ShaderView{generate_model_glsl(*result().brdf, "report.html viewer"), {}};
 }
 
 namespace {

@@ -38,14 +38,8 @@ inline constexpr int kFactorExportFormatVersion = 1;
 // Value of the sidecar's "format" field.
 inline constexpr const char* kFactorExportFormat = "brdf-factor-factorization";
 
-// Paths of the files one export wrote (absolute or as given by dir).
-struct ExportedFiles {
-  std::string sidecar;                // DIR/STEM.json
-  std::string glsl;                   // DIR/STEM.glsl
-  std::vector<std::string> textures;  // DIR/STEM_termK.exr, one per term (svd, sh-k: their EXRs)
-  std::vector<std::string> previews;  // DIR/STEM_termK.png, one per term
-  std::string data;                   // DIR/STEM.f64 (svd, sh-k, sh-r; empty otherwise)
-};
+// ExportedFiles (the paths one export wrote): factor/factorization.h.
+
 
 // Writes the export of `f` into `dir` (created if missing) with file names
 // starting with `stem` (non-empty, no '/'). Throws std::invalid_argument if the
@@ -82,11 +76,12 @@ inline constexpr uint64_t kMaxSidecarTexels = uint64_t(1) << 26;  // 64 terms of
 std::shared_ptr<HomomorphicFactorization> load_factorization(const std::string& json_path);
 
 // The export of any factorization that has one, as a run writes it with
-// experiment.export on and Factorization.export() in Python: homomorphic
-// (mccool, fit, search, refined or not) by write_factorization; svd, sh-k,
-// sh-r by write_baseline_export (factor/baseline_export.h); model-fit as
-// STEM.json (write_model_fit) and STEM.glsl (generate_model_glsl, `origin` in
-// its header comment).
+// experiment.export on and Factorization.export() in Python: checks the stem
+// (non-empty, no '/'), then f.write_export_files (factor/factorization.h):
+// homomorphic (mccool, fit, search, refined or not) by write_factorization;
+// svd, sh-k, sh-r by write_baseline_export (factor/baseline_export.h);
+// model-fit as STEM.json (write_model_fit) and STEM.glsl (generate_model_glsl,
+// `origin` in its header comment).
 // Throws std::invalid_argument naming the method when it has no export.
 ExportedFiles write_export(const Factorization& f, const std::string& dir, const std::string& stem,
                            const std::string& origin = "");

@@ -58,6 +58,11 @@ class HomomorphicFactorization final : public Factorization {
   // Masked texels x 3 channels for every term, + 3 (A) + 1 (eps) [+ 6 (log range)].
   size_t storage_floats() const override;
   nlohmann::json describe() const override;
+  // Outputs (factor/factorization.h), defined in factor/export.cpp.
+  ExportedFiles write_export_files(const std::string& dir, const std::string& stem,
+                                   const std::string& origin) const override;
+  std::string glsl(const std::string& stem, const std::string& origin) const override;
+  std::optional<ShaderView> viewer_data() const override;
 
   const std::vector<FactorTerm>& terms() const { return terms_; }
   const Rgb& A() const { return A_; }

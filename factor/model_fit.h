@@ -149,6 +149,11 @@ class ModelFitFactorization final : public Factorization {
   std::string method() const override { return "model-fit"; }
   size_t storage_floats() const override { return r_.storage_floats; }
   nlohmann::json describe() const override;
+  // Outputs (factor/factorization.h), defined in factor/export.cpp.
+  ExportedFiles write_export_files(const std::string& dir, const std::string& stem,
+                                   const std::string& origin) const override;
+  std::string glsl(const std::string& stem, const std::string& origin) const override;
+  std::optional<ShaderView> viewer_data() const override;
   const ModelFitResult& result() const { return r_; }
 
  private:

@@ -81,6 +81,11 @@ class ShkFactorization final : public Factorization {
   // Masked view texels x (F+1)^2 x 3; reduced: view_res x (F+1)^2 x 3.
   size_t storage_floats() const override;
   nlohmann::json describe() const override;
+  // Outputs (factor/factorization.h), defined in factor/baseline_export.cpp.
+  ExportedFiles write_export_files(const std::string& dir, const std::string& stem,
+                                   const std::string& origin) const override;
+  std::string glsl(const std::string& stem, const std::string& origin) const override;
+  std::optional<ShaderView> viewer_data() const override;
 
   int order() const { return opt_.order; }
   const ShkOptions& options() const { return opt_; }
@@ -197,6 +202,11 @@ class ShrFactorization final : public Factorization {
   // shr_coefficient_count(F, P) x 3.
   size_t storage_floats() const override;
   nlohmann::json describe() const override;
+  // Outputs (factor/factorization.h), defined in factor/baseline_export.cpp.
+  ExportedFiles write_export_files(const std::string& dir, const std::string& stem,
+                                   const std::string& origin) const override;
+  std::string glsl(const std::string& stem, const std::string& origin) const override;
+  std::optional<ShaderView> viewer_data() const override;
   int order() const { return F_; }
   int view_order() const { return P_; }
   double accuracy() const { return accuracy_; }

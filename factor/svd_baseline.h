@@ -123,6 +123,11 @@ class SvdFactorization final : public Factorization {
   // K * (rows + cols) * 3 masked texels + 3K singular values (+ 3 A + 1 eps in log mode).
   size_t storage_floats() const override;
   nlohmann::json describe() const override;
+  // Outputs (factor/factorization.h), defined in factor/baseline_export.cpp.
+  ExportedFiles write_export_files(const std::string& dir, const std::string& stem,
+                                   const std::string& origin) const override;
+  std::string glsl(const std::string& stem, const std::string& origin) const override;
+  std::optional<ShaderView> viewer_data() const override;
 
   int rank() const { return rank_; }
   const SvdOptions& options() const { return opt_; }

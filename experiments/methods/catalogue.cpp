@@ -9,23 +9,28 @@
 
 namespace bf {
 
-// One factory per kind, defined in its file of experiments/methods/.
-std::shared_ptr<const MethodKind> make_mccool_kind();
-std::shared_ptr<const MethodKind> make_fit_kind();
-std::shared_ptr<const MethodKind> make_search_kind();
-std::shared_ptr<const MethodKind> make_svd_kind();
-std::shared_ptr<const MethodKind> make_shk_kind();
-std::shared_ptr<const MethodKind> make_shr_kind();
-std::shared_ptr<const MethodKind> make_model_fit_kind();
+// The registration list: one line per kind, X(id) for the factory
+// `std::shared_ptr<const MethodKind> make_<id>_kind()` defined in the kind's
+// file. Its order is the order of messages and of the docs.
+#define BF_METHOD_KINDS(X) \
+  X(mccool)                \
+  X(fit)                   \
+  X(search)                \
+  X(svd)                   \
+  X(shk)                   \
+  X(shr)                   \
+  X(model_fit)
+
+#define BF_DECLARE_KIND(id) std::shared_ptr<const MethodKind> make_##id##_kind();
+BF_METHOD_KINDS(BF_DECLARE_KIND)
+#undef BF_DECLARE_KIND
 
 namespace {
 
 std::vector<std::shared_ptr<const MethodKind>>& registry() {
-  // The registration list: the order of messages and of the docs.
-  static std::vector<std::shared_ptr<const MethodKind>> kinds = {
-      make_mccool_kind(), make_fit_kind(), make_search_kind(), make_svd_kind(),
-      make_shk_kind(),    make_shr_kind(), make_model_fit_kind(),
-  };
+#define BF_LIST_KIND(id) make_##id##_kind(),
+  static std::vector<std::shared_ptr<const MethodKind>> kinds = {BF_METHOD_KINDS(BF_LIST_KIND)};
+#undef BF_LIST_KIND
   return kinds;
 }
 
@@ -94,6 +99,30 @@ std::vector<std::string> method_keys(const MethodKind& kind) {
   for (const auto& k : common_method_keys()) names.push_back(k.name);
   for (const auto& k : kind.keys()) names.push_back(k.name);
   return names;
+}
+
+MethodCallSpec method_call_spec(const MethodKind& kind) {
+  MethodCallSpec c;
+  c.kind = kind.name();
+  c.function = kind.name();
+  std::replace(c.function.begin(), c.function.end(), '-', '_');
+  c.input = kind.tabulates() ? "brdf" : "samples";
+  std::ostringstream d;
+  d << c.function << (kind.tabulates() ? "(brdf, samples=None, **options)" : "(samples, **options)")
+    << " -> Factorization\n\n"
+    << kind.summary() << "\n\nOptions: the keys of a config's kind = \"" << c.kind
+    << "\" (docs/experiments.md), as keywords; None or absent: the default.\n";
+  for (const auto& k : kind.keys()) d << "  " << k.name << ": " << k.type_cell() << ". " << k.doc << "\n";
+  d << "  metric_eps: the experiment's metric_eps (metrics on the samples).\n";
+  if (kind.tabulates()) d << "Metrics are reported when samples are given.\n";
+  c.doc = d.str();
+  return c;
+}
+
+std::vector<MethodCallSpec> method_call_specs() {
+  std::vector<MethodCallSpec> out;
+  for (const auto& k : registry()) out.push_back(method_call_spec(*k));
+  return out;
 }
 
 std::string method_key_tables() {

@@ -57,6 +57,17 @@ class HomomorphicKind : public MethodKind {
     fill_homomorphic_row(c, out, row);
   }
   void export_files(const RunContext& c, const MethodOutcome& out) const override { export_homomorphic(c, out); }
+  // The fit's errors after each term, and its metrics before a refinement.
+  void report_call(const RunContext& c, const MethodOutcome& out, bool samples_given,
+                   std::vector<double>& errors_after_term, nlohmann::json& info) const override {
+    (void)samples_given;
+    const auto* h = std::any_cast<HomomorphicRun>(&out.state);
+    if (!h) return;
+    errors_after_term = h->errors_after_term;
+    if (c.method.refine != "none")
+      info["metrics_before_refine"] = {
+          {"rel_mse", h->before.rel_mse}, {"lin_rmse", h->before.lin_rmse}, {"cos_rmse", h->before.cos_rmse}};
+  }
 };
 
 }  // namespace bf

@@ -8,10 +8,14 @@
 // name a kind: they ask the catalogue.
 //
 // A kind is a class deriving from MethodKind (a virtual interface: one object
-// per kind, no state). Adding a kind: the algorithm in factor/ or search/, one
-// file here defining the class and its factory, one line in the list of
-// methods/catalogue.cpp, a test. A test may add a kind of its own at run time
-// with register_method_kind().
+// per kind, no state). Adding a kind: the algorithm in factor/ or search/
+// (with its own Factorization subclass if no existing one fits: it carries its
+// export, GLSL and viewer data, factor/factorization.h), one file here
+// defining the class and its factory make_<id>_kind(), one line X(id) in the
+// list of methods/catalogue.cpp, a test. Python gets `bf.<name>` and
+// `bf.factor(name)` from the registry (method_call_specs below). A test may
+// add a kind of its own at run time with register_method_kind(). See
+// docs/design.md "How a method kind plugs in".
 #pragma once
 
 #include <any>
@@ -118,6 +122,18 @@ class MethodKind {
   // Whether report.html's viewer shows runs of this kind (a tabulation of the
   // original is then written beside the run, counted by the preflight).
   virtual bool has_viewer() const { return true; }
+
+  // Whether the kind tabulates the BRDF itself (svd, sh-k, sh-r) rather than
+  // fitting the samples: Python's bf.<kind>(brdf, samples=None, **options)
+  // instead of bf.<kind>(samples, **options).
+  virtual bool tabulates() const { return false; }
+  // What a direct call (Python's Factorization) reports beyond out.record:
+  // rel_mse on the samples after each term, and entries of its `info`.
+  // samples_given: false when a tabulating kind was called without samples.
+  virtual void report_call(const RunContext& c, const MethodOutcome& out, bool samples_given,
+                           std::vector<double>& errors_after_term, nlohmann::json& info) const {
+    (void)c, (void)out, (void)samples_given, (void)errors_after_term, (void)info;
+  }
 };
 
 // The registered kinds, in registration order (the order of messages and docs).
@@ -134,12 +150,38 @@ void register_method_kind(std::shared_ptr<const MethodKind> kind);
 // Removes a kind added by register_method_kind (tests; plans using it must be gone).
 void unregister_method_kind(const std::string& name);
 
+// Registers a kind for the lifetime of the object (a test's one registration
+// line), then removes it.
+class ScopedMethodKind {
+ public:
+  explicit ScopedMethodKind(std::shared_ptr<const MethodKind> kind) : name_(kind->name()) {
+    register_method_kind(std::move(kind));
+  }
+  ~ScopedMethodKind() { unregister_method_kind(name_); }
+  ScopedMethodKind(const ScopedMethodKind&) = delete;
+  ScopedMethodKind& operator=(const ScopedMethodKind&) = delete;
+
+ private:
+  std::string name_;
+};
+
 // Keys of every [[method]] table, whatever its kind: kind, label, refine, zip.
 const std::vector<KeySpec>& common_method_keys();
 // Every key a kind accepts (common keys, then its own), by name.
 std::vector<std::string> method_keys(const MethodKind& kind);
 // The names of the kinds with refinable() (for messages).
 std::vector<std::string> refinable_kind_names();
+
+// How Python calls a kind (python/src/methods.cpp binds one function per
+// registered kind from this table, python/brdf_factor/__init__.py lists them).
+struct MethodCallSpec {
+  std::string kind;      // the `kind` value, e.g. "sh-k"
+  std::string function;  // the Python name: kind with '-' as '_', e.g. "sh_k"
+  std::string input;     // "samples" (fits them) or "brdf" (tabulates it; MethodKind::tabulates)
+  std::string doc;       // the docstring: signature, summary, the keys with their types, defaults and docs
+};
+MethodCallSpec method_call_spec(const MethodKind& kind);
+std::vector<MethodCallSpec> method_call_specs();  // of every registered kind, in order
 
 // The markdown key tables of every kind, as docs/experiments.md holds them
 // between its "generated" markers and `brdf-factor list methods` prints them.

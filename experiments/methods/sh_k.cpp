@@ -89,6 +89,7 @@ class ShkKind final : public MethodKind {
     m.options["order"] = m.shk.order;
   }
 
+  bool tabulates() const override { return true; }
   void export_files(const RunContext& c, const MethodOutcome& out) const override { export_tabulated(c, out); }
   // Float64 data + float32 EXR + the viewer's base64 copy: about 18 bytes per value.
   uint64_t export_bytes(const MethodVariant& m) const override {

@@ -127,6 +127,7 @@ class ShrKind final : public MethodKind {
     o["order"] = m.shr.order;
   }
 
+  bool tabulates() const override { return true; }
   void export_files(const RunContext& c, const MethodOutcome& out) const override { export_tabulated(c, out); }
   MethodOutcome run(const RunContext& c) const override {
     const MethodVariant& m = c.method;

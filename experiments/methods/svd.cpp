@@ -100,6 +100,16 @@ class SvdKind final : public MethodKind {
     }
   }
 
+  bool tabulates() const override { return true; }
+  // rel_mse of the rank-k truncations on the samples, when given.
+  void report_call(const RunContext& c, const MethodOutcome& out, bool samples_given,
+                   std::vector<double>& errors_after_term, json& info) const override {
+    (void)info;
+    const auto svd = std::dynamic_pointer_cast<const SvdFactorization>(out.result);
+    if (!svd || !samples_given) return;
+    for (int k = 1; k <= svd->rank(); ++k)
+      errors_after_term.push_back(evaluate_metrics(*svd->truncated(k), c.samples, c.lt).rel_mse);
+  }
   void export_files(const RunContext& c, const MethodOutcome& out) const override { export_tabulated(c, out); }
   // Float64 data + float32 EXR + the viewer's base64 copy: about 18 bytes per value.
   uint64_t export_bytes(const MethodVariant& m) const override {

@@ -12,14 +12,9 @@
 #include "experiments/common/cli_util.h"
 #include "experiments/report/escape.h"
 #include "experiments/report/viewer_js.h"
-#include "factor/baseline_export.h"
-#include "factor/glsl.h"
-#include "factor/homomorphic.h"
 #include "factor/image_io.h"
 #include "factor/lighting.h"
-#include "factor/model_fit.h"
-#include "factor/model_glsl.h"
-#include "factor/svd_baseline.h"
+#include "factor/svd_baseline.h"  // DiskGrid: the original's wiwo tabulation
 
 namespace bf {
 
@@ -48,48 +43,21 @@ nlohmann::json texture_json(const std::string& sampler, const FloatImage& img) {
 
 }  // namespace
 
-namespace {
-// The fitted model of a model fit with generated GLSL, else nullptr.
-const Brdf* fitted_model(const Factorization& f) {
-  const auto* m = dynamic_cast<const ModelFitFactorization*>(&f);
-  return m && m->result().brdf && has_model_glsl(*m->result().brdf) ? m->result().brdf.get() : nullptr;
-}
-}  // namespace
-
-bool viewer_supports(const Factorization& f) {
-  return dynamic_cast<const HomomorphicFactorization*>(&f) != nullptr || is_baseline_method(f.method()) ||
-         fitted_model(f) != nullptr;
-}
-
 void write_viewer_data(const Factorization& approx, const Brdf& original, const SphereRender& original_render,
                        const SceneSettings& scene, const std::string& run_id, const std::string& label,
                        const std::string& path) {
   nlohmann::json j;
   j["label"] = label;
   j["method"] = approx.method();
+  // The result's own GLSL and textures (Factorization::viewer_data).
+  const std::optional<ShaderView> view = approx.viewer_data();
+  if (!view)
+    throw std::invalid_argument("viewer: method " + approx.method() +
+                                ": its kind declares a viewer (MethodKind::has_viewer) but its result has no "
+                                "viewer data (Factorization::viewer_data)");
+  j["glsl"] = view->glsl;
   nlohmann::json tex = nlohmann::json::array();
-  if (auto h = dynamic_cast<const HomomorphicFactorization*>(&approx)) {
-    j["glsl"] = generate_glsl(*h, {}, "report.html viewer");
-    for (size_t k = 0; k < h->terms().size(); ++k) {
-      const FactorTerm& t = h->terms()[k];
-      const int R = t.proj.res;
-      FloatImage img;
-      img.width = img.height = R;
-      img.channel_names = {"R", "G", "B"};
-      img.pixels.assign(size_t(R) * R * 3, 0.0f);
-      for (size_t q = 0; q < size_t(R) * R; ++q)
-        if (t.mask[q])
-          for (int c = 0; c < 3; ++c) img.pixels[3 * q + c] = t.texels[c][q];
-      tex.push_back(texture_json(glsl_sampler_name(k), img));
-    }
-  } else if (is_baseline_method(approx.method())) {
-    j["glsl"] = generate_baseline_glsl(approx, "factors");
-    for (const auto& [sampler, img] : baseline_textures(approx)) tex.push_back(texture_json(sampler, img));
-  } else if (const Brdf* model = fitted_model(approx)) {
-    j["glsl"] = generate_model_glsl(*model, "report.html viewer");  // model.glsl; no textures
-  } else {
-    throw std::invalid_argument("viewer: method '" + approx.method() + "' has no GLSL");
-  }
+  for (const auto& [sampler, img] : view->textures) tex.push_back(texture_json(sampler, img));
   j["textures"] = tex;
 
   if (original.isotropic()) {

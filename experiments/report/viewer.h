@@ -39,13 +39,9 @@ inline constexpr int kViewerIsoThetaH = 64, kViewerIsoThetaD = 32, kViewerIsoPhi
 // SH-lit scenes: the band-limited lighting on a W x W/2 lat-long grid.
 inline constexpr int kViewerEnvWidth = 128;
 
-// True when the viewer can show this factorization (it has exported GLSL:
-// mccool, fit, search, svd, sh-k, sh-r, and model-fit: the fitted analytic
-// model's formula, factor/model_glsl.h).
-bool viewer_supports(const Factorization& f);
-
-// Writes viewer.js (atomically). original_render: the CPU render of the
-// original (its exposure is reused).
+// Writes viewer.js (atomically) from approx.viewer_data() (factor/factorization.h);
+// throws std::invalid_argument naming the method when it has none.
+// original_render: the CPU render of the original (its exposure is reused).
 void write_viewer_data(const Factorization& approx, const Brdf& original, const SphereRender& original_render,
                        const SceneSettings& scene, const std::string& run_id, const std::string& label,
                        const std::string& path);

@@ -234,8 +234,9 @@ RunEntry execute_run(const Plan& plan, const PlannedRun& pr, const SampleSet& sa
     const SphereRender approx = render_sphere(*out.result, plan.scene);
     if (plan.experiment.render) {
       write_comparison_png(*original, approx, (run_dir / "sphere.png").string());
-      // report.html's WebGL2 viewer data (experiments/report/viewer.h).
-      if (plan.experiment.export_factors && viewer_supports(*out.result))
+      // report.html's WebGL2 viewer data (experiments/report/viewer.h), for
+      // every kind that declares a viewer (its result must have viewer data).
+      if (plan.experiment.export_factors && kind.has_viewer())
         write_viewer_data(*out.result, *plan.brdfs[pr.brdf].brdf, *original, plan.scene, pr.run_id,
                           plan.brdfs[pr.brdf].label + " | " + row["label"] + " " + row["sweep"],
                           (run_dir / "viewer.js").string());

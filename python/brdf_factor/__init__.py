@@ -15,6 +15,7 @@ import csv as _csv
 import os as _os
 import stat as _stat
 
+from . import _core
 from ._core import (  # noqa: F401  (the public API)
     Brdf,
     ConfigError,
@@ -25,11 +26,8 @@ from ._core import (  # noqa: F401  (the public API)
     data_dir,
     evaluate,
     file_formats,
-    fit,
     load,
-    mccool,
     measured_samples,
-    model_fit,
     models,
     presets,
     read_samples,
@@ -38,35 +36,30 @@ from ._core import (  # noqa: F401  (the public API)
     sample_grid,
     sample_stratified,
     score,
-    search,
-    sh_k,
-    sh_r,
-    svd,
 )
 
-__all__ = [
-    "Brdf", "ConfigError", "Factorization", "SampleSet", "brdf", "data_dir", "evaluate",
-    "factor", "file_formats", "fit", "load", "mccool", "measured_samples", "model_fit",
-    "models", "presets", "read_samples", "refine", "results", "run", "sample_grid",
-    "sample_stratified", "score", "search", "sh_k", "sh_r", "svd", "METHODS",
-]
-
 # Method kinds as the configs name them -> the function and what it factors
-# ("samples": fitted to a sample set; "brdf": tabulates the BRDF itself).
-METHODS = {
-    "mccool": (mccool, "samples"),
-    "fit": (fit, "samples"),
-    "search": (search, "samples"),
-    "svd": (svd, "brdf"),
-    "sh-k": (sh_k, "brdf"),
-    "sh-r": (sh_r, "brdf"),
-    "model-fit": (model_fit, "samples"),
-}
+# ("samples": fitted to a sample set; "brdf": tabulates the BRDF itself), one
+# per kind the catalogue registers (bf.mccool, bf.fit, bf.search, bf.svd,
+# bf.sh_k, bf.sh_r, bf.model_fit, ...), bound by the module from the registry.
+METHODS = {}
+for _kind, _function, _input in _core._method_table():
+    globals()[_function] = getattr(_core, _function)
+    METHODS[_kind] = (getattr(_core, _function), _input)
+del _kind, _function, _input
+
+__all__ = sorted([
+    "Brdf", "ConfigError", "Factorization", "SampleSet", "brdf", "data_dir", "evaluate",
+    "factor", "file_formats", "load", "measured_samples",
+    "models", "presets", "read_samples", "refine", "results", "run", "sample_grid",
+    "sample_stratified", "score",
+] + [fn.__name__ for fn, _ in METHODS.values()]) + ["METHODS"]
 
 
 def factor(kind, brdf=None, samples=None, **options):
-    """Runs method `kind` ("mccool", "fit", "search", "svd", "sh-k", "sh-r",
-    "model-fit") as a config's [[method]] with these options would.
+    """Runs method `kind` (a registered kind: the keys of METHODS, e.g.
+    "mccool", "fit", "search", "svd", "sh-k", "sh-r", "model-fit") as a
+    config's [[method]] with these options would.
 
     Sample-based kinds need `samples` (or a `brdf`, sampled on the 16^4 grid,
     the config's default sampling); tabulating kinds need `brdf` and report

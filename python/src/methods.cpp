@@ -1,5 +1,6 @@
-// Every method kind in Python: mccool, fit, search, svd, sh_k, sh_r,
-// model_fit, and refine. A call's keyword options become the [[method]] table
+// Every method kind in Python: one function per registered kind (the
+// catalogue's method_call_specs: name, input, docstring from the key docs),
+// and refine. A call's keyword options become the [[method]] table
 // a config would hold and are read by the config reader's code for that table
 // (experiments/plan/config_reader.h read_method_table, the kinds of
 // experiments/methods/): keys, defaults, ranges, rules and error messages live
@@ -15,11 +16,9 @@
 #include "common.h"
 #include "experiments/common/cli_util.h"
 #include "experiments/config/config.h"
-#include "experiments/methods/homomorphic.h"
 #include "experiments/methods/method_kind.h"
 #include "factor/isotropy.h"
 #include "factor/refine.h"
-#include "factor/svd_baseline.h"
 
 namespace bf::py_module {
 
@@ -222,15 +221,7 @@ std::shared_ptr<PyFactorization> run_kind(const MethodCall& call, const BrdfPtr&
     if (samples) p->metrics = evaluate_metrics(*out.result, s, lt);
     p->evaluations = out.evaluations;
     p->info = out.record;
-    if (const auto* h = std::any_cast<HomomorphicRun>(&out.state)) {
-      p->errors_after_term = h->errors_after_term;
-      if (m.refine != "none")
-        p->info["metrics_before_refine"] = {
-            {"rel_mse", h->before.rel_mse}, {"lin_rmse", h->before.lin_rmse}, {"cos_rmse", h->before.cos_rmse}};
-    } else if (const auto svd = std::dynamic_pointer_cast<const SvdFactorization>(out.result); svd && samples) {
-      for (int k = 1; k <= svd->rank(); ++k)
-        p->errors_after_term.push_back(evaluate_metrics(*svd->truncated(k), s, lt).rel_mse);
-    }
+    call.kind->report_call(c, out, samples != nullptr, p->errors_after_term, p->info);  // the kind's extras
     if (brdf) p->info["isotropic"] = iso.isotropic;
     if (out.choice) p->info["size_choice"] = choice_record(*out.choice);
     if (!out.notes.empty()) p->info["notes"] = out.notes;
@@ -310,64 +301,33 @@ std::shared_ptr<PyFactorization> run_refine(const PyFactorization& start, const 
 }  // namespace
 
 void bind_methods(py::module_& m) {
-  const auto on_samples = [&m](const char* name, const char* kind, const char* doc) {
-    m.def(
-        name, [kind](const std::shared_ptr<SampleSet>& s, const py::kwargs& kw) { return run_on_samples(kind, s, kw); },
-        py::arg("samples"), doc);
-  };
-  const auto on_brdf = [&m](const char* name, const char* kind, const char* doc) {
-    m.def(
-        name,
-        [kind](const PyBrdf& b, const py::object& samples, const py::kwargs& kw) {
-          return run_on_brdf(kind, b, samples, kw);
-        },
-        py::arg("brdf"), py::arg("samples") = py::none(), doc);
-  };
-  on_samples("mccool", "mccool", R"doc(mccool(samples, **options) -> Factorization
-
-McCool's fixed projections (p(wi) p(h) p(wo), two textures). Options: the keys
-of a config's kind = "mccool" (docs/experiments.md), e.g. texture_size (or
-"auto" with tolerance and texture_ladder), eps, smoothing, subtract_eps, clamp_log_range,
-solve_last, solver, refine ("none" | "linear" | "cosine" | "blend"),
-refine_blend, refine_iterations, refine_smoothing; and metric_eps (the
-experiment's).)doc");
-  on_samples("fit", "fit", R"doc(fit(samples, projections=[...], **options) -> Factorization
-
-Homomorphic fit of given projections: each a name ("wi", "wo", "h", "d"), a
-2x4 matrix (rows orthonormal) or a dict {name | matrix, parameterization,
-reciprocal}. Options: the keys of kind = "fit" (terms, texture_size,
-parameterization, reciprocity, tolerance, the fit and refinement keys).)doc");
-  on_samples("search", "search", R"doc(search(samples, **options) -> Factorization
-
-Cole's automatic factorization (Powell search over 4D rotations); with
-strategy="structured" the search of docs/search.md. Options: the keys of
-kind = "search" (strategy, terms, parameterization, texture_size,
-search_texture_size, restarts, guesses, optimizer, threads, seed, beam,
-tolerance, the fit and refinement keys, ...). An explicit parameterization is
-every term's (term_param "fixed"); without it the structured search chooses
-per term. info["term_parameterizations"] and info["search_strategy"] say what
-each term read and which strategy won.)doc");
-  on_brdf("svd", "svd", R"doc(svd(brdf, samples=None, **options) -> Factorization
-
-Kautz-McCool SVD of the tabulated BRDF. Options: the keys of kind = "svd"
-(texture_size, terms, parameterization, log, eps, subtract_eps, rim_inset,
-extend_below_horizon, float_textures, tolerance (needs samples)). Metrics
-are reported when samples are given.)doc");
-  on_brdf("sh_k", "sh-k", R"doc(sh_k(brdf, samples=None, **options) -> Factorization
-
-Kautz-Sloan-Snyder SH projection. Options: the keys of kind = "sh-k" (order,
-texture_size, theta_nodes, phi_nodes, rim_inset, min_cos, float_textures,
-reduce_isotropic, tolerance (needs samples)).)doc");
-  on_brdf("sh_r", "sh-r", R"doc(sh_r(brdf, samples=None, **options) -> Factorization
-
-Ramamoorthi-Hanrahan reflection-space SH (isotropic BRDFs). Options: the keys
-of kind = "sh-r" (order, view_order, max_order, max_view_order, energy_eps,
-theta_i_nodes, theta_o_nodes, phi_nodes, min_cos, tolerance (needs samples)).)doc");
-  on_samples("model_fit", "model-fit", R"doc(model_fit(samples, **options) -> Factorization
-
-Ceres fit of an analytic model. Options: the keys of kind = "model-fit"
-(model, metric, cube_root, anisotropic, lobes, eps, starts, seed,
-max_iterations, threads).)doc");
+  // One function per registered kind (bf.<kind>, '-' as '_'), its docstring
+  // from the kind's summary and key docs (experiments/methods/method_kind.h).
+  static const std::vector<MethodCallSpec> specs = method_call_specs();  // outlives the module's docstrings
+  for (const MethodCallSpec& spec : specs) {
+    const std::string kind = spec.kind;
+    if (spec.input == "brdf")
+      m.def(
+          spec.function.c_str(),
+          [kind](const PyBrdf& b, const py::object& samples, const py::kwargs& kw) {
+            return run_on_brdf(kind, b, samples, kw);
+          },
+          py::arg("brdf"), py::arg("samples") = py::none(), spec.doc.c_str());
+    else
+      m.def(
+          spec.function.c_str(),
+          [kind](const std::shared_ptr<SampleSet>& s, const py::kwargs& kw) { return run_on_samples(kind, s, kw); },
+          py::arg("samples"), spec.doc.c_str());
+  }
+  m.def(
+      "_method_table",
+      [] {
+        py::list out;
+        for (const MethodCallSpec& spec : method_call_specs())
+          out.append(py::make_tuple(spec.kind, spec.function, spec.input));
+        return out;
+      },
+      "[(kind, function name, \"samples\" | \"brdf\")] of every registered method kind, in order.");
   m.def(
       "_method_examples",
       [] {
