@@ -215,3 +215,44 @@ def test_option_errors_state_the_cli_rule(tmp_path, cli, grid8, bluepaint, kind,
     with pytest.raises(ValueError) as e:
         bf.factor(kind, brdf=bluepaint, samples=grid8, **options)
     assert str(e.value).splitlines() == [kind + ": " + rule for rule in cli_rules]
+
+
+# ------------------------------------------------------------ every registered kind
+
+def _toml(v):
+    """A value of a kind's example options (_method_examples) as TOML."""
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, str):
+        return '"%s"' % v.replace("\\", "\\\\").replace('"', '\\"')
+    if isinstance(v, dict):
+        return "{ " + ", ".join("%s = %s" % (k, _toml(x)) for k, x in v.items()) + " }"
+    if isinstance(v, (list, tuple)):
+        return "[" + ", ".join(_toml(x) for x in v) + "]"
+    return repr(v)
+
+
+def test_every_registered_kind_runs_the_same_from_a_config_and_from_python(tmp_path, bluepaint):
+    # The kinds come from the registry (_core._method_examples: every kind
+    # with its small example options), not from a list here.
+    from brdf_factor import _core
+    examples = _core._method_examples()
+    assert sorted(examples) == sorted(bf.METHODS)
+    cfg = CONFIG.split("[[method]]")[0]
+    for kind, options in examples.items():
+        cfg += "[[method]]\nkind = \"%s\"\n" % kind + "".join("%s = %s\n" % (k, _toml(v)) for k, v in options.items())
+    (tmp_path / "kinds.toml").write_text(cfg)
+    rows = bf.run(tmp_path / "kinds.toml", out=tmp_path / "out").results()
+    assert sorted(r["method"] for r in rows) == sorted(examples)
+    s = bf.sample_grid(bluepaint, 8)
+    for row in rows:
+        kind = row["method"]
+        f = bf.factor(kind, brdf=bluepaint, samples=s, **examples[kind])
+        assert f.method == kind
+        assert f.metrics["rel_mse"] == pytest.approx(row["rel_mse"], rel=1e-8, abs=0), kind
+        assert f.storage_floats == row["storage_floats"], kind
+        # The function bf.<kind> ('-' as '_') is the registry's, with its keys documented.
+        fn, needs = bf.METHODS[kind]
+        assert getattr(bf, kind.replace("-", "_")) is fn and needs in ("samples", "brdf")
+        for key in options:
+            assert key in fn.__doc__, (kind, key)

@@ -4,15 +4,19 @@
 // render of the run's export, its slices equal `eval` of the export, and its
 // original panel (the page's tabulation) is close to the CPU render and eval
 // of the BRDF; under SH lighting the page shades as render_sphere, also with
-// the environment turned by a dragged light. Kinds: mccool, svd (halfdiff, log), sh-k (reduced and full),
-// sh-r, model-fit (lafortune).
+// the environment turned by a dragged light. Kinds: every registered kind
+// with a viewer (MethodKind::has_viewer) from its example, and svd (halfdiff,
+// log), sh-k (reduced and full), model-fit (lafortune).
 #include <cmath>
 #include <cstdlib>
+#include <map>
+#include <set>
 #include <nlohmann/json.hpp>
 
 #include "brdfs/catalogue.h"
 #include "brdfs/directions.h"
 #include "experiments/config/config.h"
+#include "experiments/methods/method_kind.h"
 #include "experiments/report/render.h"
 #include "experiments_helpers.h"
 
@@ -21,7 +25,11 @@ using namespace bf_test;
 
 namespace {
 
-const char* kViewerConfig = R"(
+// Every registered kind with a viewer, from its example, plus variants that
+// take other paths through the shaders (halfdiff log SVD, both SH-K layouts,
+// Lafortune lobes).
+std::string viewer_config() {
+  std::string cfg = R"(
 [experiment]
 name = "viewer"
 seed = 3
@@ -35,11 +43,10 @@ resolution = 6
 
 [scene]
 size = 40
-
-[[method]]
-kind = "mccool"
-texture_size = 8
-
+)";
+  for (const auto& kind : method_kinds())
+    if (kind->has_viewer()) cfg += "\n[[method]]\nkind = \"" + kind->name() + "\"\n" + kind->example();
+  return cfg + R"(
 [[method]]
 kind = "svd"
 parameterization = "halfdiff"
@@ -54,15 +61,13 @@ texture_size = 8
 reduce_isotropic = [true, false]
 
 [[method]]
-kind = "sh-r"
-
-[[method]]
 kind = "model-fit"
 model = "lafortune"
 starts = 1
 max_iterations = 30
 threads = 1
 )";
+}
 
 std::string chromium() {
   for (const char* c : {"chromium", "chromium-browser"})
@@ -84,7 +89,7 @@ TEST_CASE("viewer: headless Chromium renders every kind as the CPU does") {
   INFO("chromium not installed (scripts/install-deps.sh installs it)");
   REQUIRE(!browser.empty());
   ScratchDir dir;
-  const std::string cfg = write_text(dir / "viewer.toml", kViewerConfig);
+  const std::string cfg = write_text(dir / "viewer.toml", viewer_config());
   const RunSummary s = run_quiet(cfg, dir / "out");
   REQUIRE(s.failed == 0);
   const std::string page = dir / "out/report.html";
@@ -104,6 +109,9 @@ TEST_CASE("viewer: headless Chromium renders every kind as the CPU does") {
   std::istringstream lines(text.substr(open, close - open));
   std::string line;
   int runs = 0, drags = 0;
+  std::set<std::string> shown;  // kinds the page drew
+  std::map<std::string, std::string> kind_of;  // run id -> the results' method column
+  for (const Row& row : read_results_csv(dir / "out/results.csv")) kind_of[row.at("run_id")] = row.at("method");
   register_loaders();
   const BrdfPtr original = Catalogue::global().make("bluepaint");
   SceneSettings scene;
@@ -128,6 +136,7 @@ TEST_CASE("viewer: headless Chromium renders every kind as the CPU does") {
     INFO("run " << id << " " << (j.contains("error") ? j["error"].get<std::string>() : ""));
     REQUIRE(!j.contains("error"));
     ++runs;
+    shown.insert(kind_of.at(id));
     // The run's export: factors.json, or model.json for a model fit.
     const std::string run_dir = dir / ("out/runs/" + id);
     const BrdfPtr approx = Catalogue::global().make(run_dir + (std::filesystem::exists(run_dir + "/model.json")
@@ -204,7 +213,12 @@ TEST_CASE("viewer: headless Chromium renders every kind as the CPU does") {
       CHECK(w <= 3e-3 * pk);
     }
   }
-  CHECK(runs == 6);
+  CHECK(runs == int(s.executed));
+  for (const auto& kind : method_kinds())
+    if (kind->has_viewer()) {
+      INFO(kind->name());
+      CHECK(shown.count(kind->name()) == 1);
+    }
   CHECK(drags == 1);
 }
 
