@@ -16,6 +16,8 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <map>
+#include <mutex>
 #include <sstream>
 #include <stdexcept>
 
@@ -569,8 +571,38 @@ json read_sidecar_json(const std::string& path) {
 
 }  // namespace
 
+namespace {
+
+// Readers of result types outside the formats below, by the sidecar's method.
+std::map<std::string, ExportReader>& export_readers() {
+  static std::map<std::string, ExportReader> readers;
+  return readers;
+}
+std::mutex& export_readers_mutex() {
+  static std::mutex mu;
+  return mu;
+}
+
+}  // namespace
+
+void register_export_reader(const std::string& method, ExportReader read) {
+  std::lock_guard<std::mutex> lk(export_readers_mutex());
+  if (!read) export_readers().erase(method);
+  else export_readers()[method] = std::move(read);
+}
+
 BrdfPtr load_export(const std::string& json_path) {
   const json j = read_sidecar_json(json_path);
+  // A result type that registered its reader (register_export_reader).
+  if (j.is_object() && j.contains("method") && j["method"].is_string()) {
+    ExportReader read;
+    {
+      std::lock_guard<std::mutex> lk(export_readers_mutex());
+      const auto it = export_readers().find(j["method"].get<std::string>());
+      if (it != export_readers().end()) read = it->second;
+    }
+    if (read) return read(json_path);
+  }
   // A model fit's file (factor/model_fit.h) is a catalogue spec in JSON.
   if (j.is_object() && j.contains("format") && j["format"] == kModelFitFormat) return load_model_fit(json_path);
   // SVD / SH exports (factor/baseline_export.h) dispatch on the sidecar's method.

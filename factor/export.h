@@ -22,6 +22,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -90,6 +91,13 @@ ExportedFiles write_export(const Factorization& f, const std::string& dir, const
 // as the ".json" loader below does): a model fit's catalogue BRDF, or the
 // factorization. The file is checked as every reader's (brdfs/file_check.h).
 BrdfPtr load_export(const std::string& json_path);
+
+// Reads back the export of a result type outside those formats: load_export
+// (and so the ".json" loader, `--brdf STEM.json`, Python's bf.load) calls
+// `read` for a sidecar whose "method" is `method`, before the built-in
+// formats. An empty `read` removes the reader (tests).
+using ExportReader = std::function<std::shared_ptr<const Factorization>(const std::string& json_path)>;
+void register_export_reader(const std::string& method, ExportReader read);
 
 // Registers the ".json" loader, so a sidecar path works wherever a BRDF spec is
 // accepted (`--brdf results/run/factors.json`). It takes no options.

@@ -1,6 +1,7 @@
 // A method kind with a result type of its own, defined in this file and
 // registered by one line: a run of it through a config writes its export and
-// its viewer data, its GLSL compiles for every target, report.html's viewer
+// its viewer data, its GLSL compiles for every target, the export reloads
+// once its (optional) reader is registered, report.html's viewer
 // lists it, and Python's binding table (method_call_specs, which
 // python/src/methods.cpp binds as bf.<kind> and bf.factor(kind)) has it with
 // its keys documented. Nothing outside this file names it. (The Python module
@@ -8,10 +9,13 @@
 // checked on the table the module is bound from.)
 #include <fstream>
 
+#include "brdfs/catalogue.h"
 #include "experiments/methods/method_kind.h"
 #include "experiments_helpers.h"
+#include "factor/export.h"
 #include "factor/glsl_compile.h"
 #include "factor/glsl_target.h"
+#include "factor/metrics.h"
 
 using namespace bf;
 using namespace bf_test;
@@ -90,6 +94,13 @@ class ToyTintKind final : public MethodKind {
   }
 };
 
+// Reads a toy-tint export back (its optional reader: load_export, --brdf).
+std::shared_ptr<const Factorization> read_tint(const std::string& path) {
+  const nlohmann::json j = nlohmann::json::parse(read_text(path));
+  const auto& rho = j.at("rho");
+  return std::make_shared<TintFactorization>(Rgb(rho[0].get<double>(), rho[1].get<double>(), rho[2].get<double>()));
+}
+
 // The JSON object a viewer.js assigns.
 nlohmann::json viewer_json(const std::string& text) {
   const size_t a = text.find("] = "), b = text.rfind(';');
@@ -139,6 +150,18 @@ TEST_CASE("kinds: a kind with its own result type gets export GLSL viewer and Py
   const std::string err = compile_glsl_all_targets(glsl, tmp.path);
   INFO(err);
   CHECK(err.empty());
+  {  // With its reader registered, the export reloads as a BRDF spec and scores the run's rel_mse.
+    register_export_reader("toy-tint", read_tint);
+    struct Unregister {
+      ~Unregister() { register_export_reader("toy-tint", nullptr); }
+    } unregister;
+    register_loaders();
+    const BrdfPtr back = Catalogue::global().make((run / "factors.json").string());
+    const SampleSet samples = sample_grid(*Catalogue::builtin().make("bluepaint"), 6);
+    const double got = evaluate_metrics(*back, samples, LogTransform::of(samples, 1e-5)).rel_mse;
+    const double want = std::stod(rows[0].at("rel_mse"));
+    CHECK(std::abs(got - want) <= 1e-6 * std::abs(want));
+  }
 
   // The viewer: viewer.js holds the result's viewer data, and report.html lists the run.
   REQUIRE(fs::exists(run / "viewer.js"));
