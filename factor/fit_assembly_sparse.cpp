@@ -322,6 +322,23 @@ void assemble_sparse_csc(const FitData& d, const std::array<const double*, 3>& r
       for (int c = 0; c < 3; ++c) rhs(prior.idx[a], c) += prior.w[pr] * prior.val[a] * prior.target[pr][c];
 }
 
+void standalone_system(const FitData& d, const std::vector<TermSpec>& joint, const FitOptions& opt,
+                       StandaloneSystem& sys) {
+  opt.validate();
+  if (joint.empty()) throw std::invalid_argument("fit: no terms to solve");
+  sys.own.resize(joint.size());
+  for (size_t i = 0; i < joint.size(); ++i) {
+    add_layout(d, joint[i], sys.M, sys.terms, sys.own[i]);
+    sys.lookups.push_back(&sys.own[i]);
+  }
+  const std::array<std::vector<double>, 3> no_fixed{std::vector<double>(d.size(), 0.0),
+                                                    std::vector<double>(d.size(), 0.0),
+                                                    std::vector<double>(d.size(), 0.0)};
+  sys.prior = extrapolation_prior(d, no_fixed, sys.terms, sys.lookups, sys.M, opt);
+  sys.mu = opt.smoothing * d.W / std::max(sys.M, 1);
+  sys.r = {d.g[0].data(), d.g[1].data(), d.g[2].data()};
+}
+
 }  // namespace bf::fit
 
 namespace bf {
@@ -329,26 +346,12 @@ namespace bf {
 using namespace fit;
 
 SparseNormal sparse_normal_equations(const FitData& d, const std::vector<TermSpec>& joint, const FitOptions& opt) {
-  opt.validate();
-  if (joint.empty()) throw std::invalid_argument("fit: no terms to solve");
-  std::vector<TermLayout> terms;
-  std::vector<std::array<Lookups, 2>> own(joint.size());
-  std::vector<const std::array<Lookups, 2>*> lookups;
-  int M = 0;
-  for (size_t i = 0; i < joint.size(); ++i) {
-    add_layout(d, joint[i], M, terms, own[i]);
-    lookups.push_back(&own[i]);
-  }
-  const std::array<std::vector<double>, 3> no_fixed{std::vector<double>(d.size(), 0.0),
-                                                    std::vector<double>(d.size(), 0.0),
-                                                    std::vector<double>(d.size(), 0.0)};
-  const Prior prior = extrapolation_prior(d, no_fixed, terms, lookups, M, opt);
-  const double mu = opt.smoothing * d.W / std::max(M, 1);
-  const std::array<const double*, 3> r = {d.g[0].data(), d.g[1].data(), d.g[2].data()};
+  StandaloneSystem sys;
+  standalone_system(d, joint, opt, sys);
   SparseNormal out;
-  out.M = M;
+  out.M = sys.M;
   Csc A;
-  assemble_sparse_csc(d, r, terms, lookups, mu, prior, M, A, out.rhs);
+  assemble_sparse_csc(d, sys.r, sys.terms, sys.lookups, sys.mu, sys.prior, sys.M, A, out.rhs);
   out.p = std::move(A.p);
   out.i = std::move(A.i);
   out.x = std::move(A.x);

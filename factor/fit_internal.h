@@ -311,6 +311,22 @@ void assemble_sparse_csc(const FitData& d, const std::array<const double*, 3>& r
                          const std::vector<const std::array<Lookups, 2>*>& lookups, double mu,
                          const Prior& prior, int M, Csc& A, Eigen::MatrixXd& rhs);
 
+// The system of `joint` alone (no fixed terms, the targets d.g): layouts,
+// lookups (in own), prior rows and smoothing weight, as solve_joint builds
+// them. Filled in place (lookups point into own). Throws
+// std::invalid_argument as solve_joint does.
+struct StandaloneSystem {
+  std::vector<TermLayout> terms;
+  std::vector<std::array<Lookups, 2>> own;
+  std::vector<const std::array<Lookups, 2>*> lookups;
+  int M = 0;
+  Prior prior;
+  double mu = 0;
+  std::array<const double*, 3> r{};
+};
+void standalone_system(const FitData& d, const std::vector<TermSpec>& joint, const FitOptions& opt,
+                       StandaloneSystem& sys);
+
 // The joint system's layout: the terms in order (a JointPrefix's first, K of
 // them), each term's lookups, M unknowns in all.
 struct JointSystem {

@@ -186,27 +186,14 @@ void assemble_triplets(const FitData& d, const std::array<const double*, 3>& r,
 
 SparseNormal reference_sparse_normal_equations(const FitData& d, const std::vector<TermSpec>& joint,
                                                const FitOptions& opt) {
-  opt.validate();
-  std::vector<TermLayout> terms;
-  std::vector<std::array<Lookups, 2>> own(joint.size());
-  std::vector<const std::array<Lookups, 2>*> lookups;
-  int M = 0;
-  for (size_t i = 0; i < joint.size(); ++i) {
-    add_layout(d, joint[i], M, terms, own[i]);
-    lookups.push_back(&own[i]);
-  }
-  const std::array<std::vector<double>, 3> no_fixed{std::vector<double>(d.size(), 0.0),
-                                                    std::vector<double>(d.size(), 0.0),
-                                                    std::vector<double>(d.size(), 0.0)};
-  const Prior prior = extrapolation_prior(d, no_fixed, terms, lookups, M, opt);
-  const double mu = opt.smoothing * d.W / std::max(M, 1);
-  const std::array<const double*, 3> r = {d.g[0].data(), d.g[1].data(), d.g[2].data()};
+  StandaloneSystem sys;
+  standalone_system(d, joint, opt, sys);
   SparseNormal out;
-  out.M = M;
+  out.M = sys.M;
   SparseUpper A;
-  assemble_triplets(d, r, terms, lookups, mu, prior, M, A, out.rhs);
+  assemble_triplets(d, sys.r, sys.terms, sys.lookups, sys.mu, sys.prior, sys.M, A, out.rhs);
   A.makeCompressed();
-  out.p.assign(A.outerIndexPtr(), A.outerIndexPtr() + M + 1);
+  out.p.assign(A.outerIndexPtr(), A.outerIndexPtr() + sys.M + 1);
   out.i.assign(A.innerIndexPtr(), A.innerIndexPtr() + A.nonZeros());
   out.x.assign(A.valuePtr(), A.valuePtr() + A.nonZeros());
   return out;
