@@ -1,6 +1,7 @@
 // Registers every analytic model with the catalogue, and holds the pieces the
 // model sources share (Fresnel terms, parameter checks, number formatting).
 #include "brdfs/models.h"
+#include "brdfs/models_internal.h"
 
 #include <algorithm>
 #include <charconv>

@@ -3,6 +3,7 @@
 
 #include "brdfs/catalogue.h"
 #include "brdfs/models.h"
+#include "brdfs/models_internal.h"
 
 namespace bf {
 

@@ -1,6 +1,7 @@
 // Lambert: f = kd / pi (constant), the simplest catalogue model.
 #include "brdfs/catalogue.h"
 #include "brdfs/models.h"
+#include "brdfs/models_internal.h"
 
 namespace bf {
 

@@ -4,6 +4,7 @@
 
 #include "brdfs/catalogue.h"
 #include "brdfs/models.h"
+#include "brdfs/models_internal.h"
 
 namespace bf {
 

@@ -1,4 +1,4 @@
-// The homomorphic fit's assembly kernels (factor/homomorphic_fit.cpp, dense
+// The homomorphic fit's assembly kernels (factor/fit_assembly.cpp and fit_assembly_sparse.cpp, dense
 // path): per-sample lookups, per-cell self-product sums and the cross products
 // of two lookups scattered into the normal matrix. Like the Cholesky
 // (factor/dense_kernels.h) they are compiled once per instruction set and

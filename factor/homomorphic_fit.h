@@ -67,9 +67,9 @@ struct FitOptions {
   // Dense: normal matrix assembled densely, LLT. Sparse: normal matrix assembled
   // column by column in compressed columns, CHOLMOD supernodal LLT ordered by AMD on
   // pairs of texels (SimplicialLLT with AMD without CHOLMOD).
-  // Auto: dense up to 1,650 unknowns (2,200 with 500,000 samples or more), sparse above (measured
-  // crossovers, docs/speed.md "Dense against sparse, round 3"). ReferenceQR: the
-  // simple path (dense B, Householder QR, no normal equations) for tests.
+  // Auto: dense for small systems, sparse above (choose_linear_solver,
+  // factor/solver_choice.h). ReferenceQR: the simple path (dense B,
+  // Householder QR, no normal equations) for tests.
   enum class Solver { Auto, Dense, Sparse, ReferenceQR } solver = Solver::Auto;
   // Upper bound of smoothing and extrapolation_prior (in mean sample weights).
   // Far above it the Laplacian or the prior swamps the samples' rows of the
@@ -152,6 +152,7 @@ class JointPrefix {
   JointPrefix(const JointPrefix&) = delete;
   JointPrefix& operator=(const JointPrefix&) = delete;
   size_t terms() const;
+  // The content, defined in factor/fit_internal.h (the fit's own files only).
   struct Impl;
   const Impl& impl() const { return *impl_; }
 
@@ -192,20 +193,19 @@ Eigen::MatrixXd joint_normal_matrix(const FitData& d, const std::vector<TermSpec
                                     size_t max_unknowns, size_t* unknowns = nullptr);
 
 // The sparse path's normal equations for `joint` alone (no fixed terms, the
-// targets d.g), before its gauge and ridge: A's upper triangle in compressed
-// columns (p: M + 1 column starts, i: rows, x: values; rows sorted, every
-// diagonal entry stored, hence last in its column) and rhs (M x 3), in
-// solve_joint's unknown layout. `reference`: the triplet assembly (Eigen's
-// setFromTriplets) the column-by-column assembly replaced, the simple path
-// tests compare it with. Throws std::invalid_argument as solve_joint does.
+// targets d.g), before its gauge and ridge: A = B^T W B + mu L^T L + the
+// prior's rows, rhs = B^T W g + the prior's targets, A's upper triangle in
+// compressed columns (p: M + 1 column starts, i: rows, x: values; rows
+// sorted, every diagonal entry stored, hence last in its column) and rhs
+// (M x 3), in solve_joint's unknown layout. Throws std::invalid_argument as
+// solve_joint does.
 struct SparseNormal {
   int M = 0;
   std::vector<int> p, i;
   std::vector<double> x;
   Eigen::MatrixXd rhs;
 };
-SparseNormal sparse_normal_equations(const FitData& d, const std::vector<TermSpec>& joint, const FitOptions& opt,
-                                     bool reference);
+SparseNormal sparse_normal_equations(const FitData& d, const std::vector<TermSpec>& joint, const FitOptions& opt);
 
 // McCool's fixed projections (thesis 2.1.1): p(wi) and p(wo) share one texture
 // (a reciprocal wiwo term), q(h) has its own (halfdiff, first pair; h through

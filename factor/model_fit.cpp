@@ -22,6 +22,7 @@
 #include "factor/ceres_cancel.h"
 #include "brdfs/catalogue.h"
 #include "brdfs/models.h"
+#include "brdfs/models_internal.h"
 #include "brdfs/params.h"
 #include "factor/metrics.h"
 #include "solvers/option_error.h"

@@ -1,6 +1,7 @@
 // Nonlinear refinement of homomorphic factorizations with Ceres (see refine.h).
 #include "factor/refine.h"
 #include "factor/ceres_cancel.h"
+#include "factor/refine_internal.h"
 #include "solvers/option_error.h"
 #include "solvers/parallel.h"
 
@@ -18,14 +19,8 @@ namespace bf {
 
 namespace {
 
-enum class Objective { Linear, Cosine, Blend };
-
-Objective parse_objective(const std::string& s) {
-  if (s == "linear") return Objective::Linear;
-  if (s == "cosine") return Objective::Cosine;
-  if (s == "blend") return Objective::Blend;
-  throw std::invalid_argument("objective: expected linear, cosine or blend, found '" + s + "'");
-}
+using detail::RefineObjective;
+using Objective = RefineObjective;
 
 // One sample's residuals in one channel (refine.h): the log-space model value
 // s is the weighted sum of the distinct texels of the sample's stencil (one
@@ -129,7 +124,7 @@ void choose_linear_solver(RefineOptions::LinearSolver which, ceres::Solver::Opti
 }  // namespace
 
 void RefineOptions::validate() const {
-  parse_objective(objective);
+  detail::parse_refine_objective(objective);
   const auto shown = [](double v) {
     std::ostringstream s;
     s.precision(12);
@@ -154,103 +149,108 @@ void RefineOptions::validate() const {
 }
 
 namespace detail {
+RefineObjective parse_refine_objective(const std::string& s) {
+  if (s == "linear") return RefineObjective::Linear;
+  if (s == "cosine") return RefineObjective::Cosine;
+  if (s == "blend") return RefineObjective::Blend;
+  throw std::invalid_argument("objective: expected linear, cosine or blend, found '" + s + "'");
+}
+
 std::unique_ptr<ceres::CostFunction> make_refine_sample_cost(const std::vector<double>& weights,
                                                              double f, double sw, double cosw,
                                                              double A, double scale, double eps,
-                                                             bool subtract_eps,
-                                                             const std::string& objective,
+                                                             bool subtract_eps, RefineObjective objective,
                                                              double blend_weight) {
-  return std::make_unique<SampleCost>(weights, f, sw, cosw, A, scale, eps, subtract_eps,
-                                      parse_objective(objective), blend_weight);
+  return std::make_unique<SampleCost>(weights, f, sw, cosw, A, scale, eps, subtract_eps, objective,
+                                      blend_weight);
 }
 }  // namespace detail
 
-std::shared_ptr<HomomorphicFactorization> refine(const HomomorphicFactorization& start,
-                                                 const SampleSet& samples,
-                                                 const RefineOptions& opt, RefineReport* report) {
-  const auto t0 = std::chrono::steady_clock::now();
-  opt.validate();
-  const Objective obj = parse_objective(opt.objective);
-  if (start.terms().empty()) throw std::invalid_argument("refine: the start has no terms");
+namespace {
 
-  // Valid samples, their weights and points.
-  std::vector<size_t> ks;
-  double W = 0;
-  for (size_t k = 0; k < samples.size(); ++k)
-    if (samples.valid[k]) {
-      ks.push_back(k);
-      W += samples.weight_of(k);
-    }
-  if (ks.empty()) throw std::invalid_argument("refine: the sample set has no valid sample");
-  if (!(W > 0.0)) throw std::invalid_argument("refine: the valid samples' weights sum to 0");
-  const size_t N = ks.size();
-
-  // Terms: projections (direct and conjugate), masks extended by every texel a
-  // sample reads, and the texel -> unknown map.
-  std::vector<FactorTerm> terms = start.terms();
-  struct Layout {
+// The refined problem's layout: the valid samples (ks, weight sum W), the
+// terms' masks extended by every texel a sample reads (added of them), each
+// term's texel -> unknown map, and per (sample, term) the direct and
+// conjugate bilinear stencils.
+struct RefineLayout {
+  struct Term {
     Projection conj;
     std::vector<int> unk;
     int first = 0;
   };
-  std::vector<Layout> lay(terms.size());
+  std::vector<size_t> ks;
+  double W = 0;
+  std::vector<Term> lay;
   std::vector<std::array<Bilinear, 2>> stencils;  // per (sample, term): direct, conjugate
-  stencils.resize(N * terms.size());
   size_t added = 0;
   int M = 0;
+};
+
+RefineLayout refine_layout(std::vector<FactorTerm>& terms, const SampleSet& samples) {
+  RefineLayout L;
+  for (size_t k = 0; k < samples.size(); ++k)
+    if (samples.valid[k]) {
+      L.ks.push_back(k);
+      L.W += samples.weight_of(k);
+    }
+  if (L.ks.empty()) throw std::invalid_argument("refine: the sample set has no valid sample");
+  if (!(L.W > 0.0)) throw std::invalid_argument("refine: the valid samples' weights sum to 0");
+  const size_t N = L.ks.size();
+  L.lay.resize(terms.size());
+  L.stencils.resize(N * terms.size());
   for (size_t t = 0; t < terms.size(); ++t) {
     FactorTerm& term = terms[t];
     const int R = term.proj.res;
     if (term.mask.size() != size_t(R) * R) term.mask.assign(size_t(R) * R, 1);
-    lay[t].conj = term.proj.conjugate();
+    L.lay[t].conj = term.proj.conjugate();
     for (size_t n = 0; n < N; ++n) {
-      const size_t k = ks[n];
+      const size_t k = L.ks[n];
       const Vec4 x = to_point(term.proj.param, samples.wi[k], samples.wo[k]);
-      auto& st = stencils[n * terms.size() + t];
+      auto& st = L.stencils[n * terms.size() + t];
       st[0] = bilinear(term.proj.texel_coords(x), R);
-      if (term.reciprocal) st[1] = bilinear(lay[t].conj.texel_coords(x), R);
+      if (term.reciprocal) st[1] = bilinear(L.lay[t].conj.texel_coords(x), R);
       for (int q = 0; q < (term.reciprocal ? 2 : 1); ++q)
         for (int a = 0; a < 4; ++a)
           if (!term.mask[st[q].idx[a]]) {
             term.mask[st[q].idx[a]] = 1;
-            ++added;
+            ++L.added;
           }
     }
-    lay[t].unk.assign(term.mask.size(), -1);
-    lay[t].first = M;
+    L.lay[t].unk.assign(term.mask.size(), -1);
+    L.lay[t].first = L.M;
     for (size_t i = 0; i < term.mask.size(); ++i)
-      if (term.mask[i]) lay[t].unk[i] = M++;
+      if (term.mask[i]) L.lay[t].unk[i] = L.M++;
   }
+  return L;
+}
 
-  // Parameters: one double (log texel) per unknown and channel, from the start;
-  // channel c of unknown u is y[c * M + u].
-  std::vector<double> y(size_t(3) * M);
+// One residual block per valid sample and channel (the sample's distinct
+// texels, merged weights); returns the number of scalar residuals.
+// y: channel c of unknown u at y[c * M + u].
+size_t add_sample_residuals(ceres::Problem& problem, const RefineLayout& L, const std::vector<FactorTerm>& terms,
+                            const SampleSet& samples, const HomomorphicFactorization& start, Objective obj,
+                            double blend_weight, std::vector<double>& y) {
+  const int M = L.M;
   auto at = [&](int c, int u) { return &y[size_t(c) * M + u]; };
-  for (size_t t = 0; t < terms.size(); ++t)
-    for (size_t i = 0; i < terms[t].mask.size(); ++i)
-      if (lay[t].unk[i] >= 0)
-        for (int c = 0; c < 3; ++c) *at(c, lay[t].unk[i]) = terms[t].texels[c][i];
-
   // Linear residuals are in units of the mean of A over the channels, so the
   // channels weigh as in lin_rmse.
   const double scale = start.A().mean();
-  ceres::Problem problem;
   size_t residuals = 0;
   std::vector<int> ids;
   std::vector<double> ws;
   std::vector<double*> blocks;
   std::unordered_map<int, size_t> pos;
-  for (size_t n = 0; n < N; ++n) {
-    const size_t k = ks[n];
+  for (size_t n = 0; n < L.ks.size(); ++n) {
+    const size_t k = L.ks[n];
     ids.clear();
     ws.clear();
     pos.clear();
     for (size_t t = 0; t < terms.size(); ++t) {
-      const auto& st = stencils[n * terms.size() + t];
+      const auto& st = L.stencils[n * terms.size() + t];
       for (int q = 0; q < (terms[t].reciprocal ? 2 : 1); ++q)
         for (int a = 0; a < 4; ++a) {
           if (st[q].w[a] == 0.0) continue;
-          const int id = lay[t].unk[st[q].idx[a]];
+          const int id = L.lay[t].unk[st[q].idx[a]];
           auto it = pos.find(id);
           if (it == pos.end()) {
             pos.emplace(id, ids.size());
@@ -262,48 +262,85 @@ std::shared_ptr<HomomorphicFactorization> refine(const HomomorphicFactorization&
         }
     }
     if (ids.empty()) continue;
-    const double sw = std::sqrt(samples.weight_of(k) / (3.0 * W));
+    const double sw = std::sqrt(samples.weight_of(k) / (3.0 * L.W));
     const double cosw = obj == Objective::Cosine ? std::max(samples.wi[k].z(), 0.0) : 1.0;
     for (int c = 0; c < 3; ++c) {
       blocks.clear();
       for (int id : ids) blocks.push_back(at(c, id));
       auto* cost = new SampleCost(ws, samples.value[k][c], sw, cosw, start.A()[c], scale, start.eps(),
-                                  start.subtract_eps(), obj, opt.blend_weight);
+                                  start.subtract_eps(), obj, blend_weight);
       residuals += cost->num_residuals();
       problem.AddResidualBlock(cost, nullptr, blocks);
     }
   }
+  return residuals;
+}
 
-  // Laplacian rows (4-neighbours inside each term's mask).
-  if (opt.smoothing > 0.0) {
-    const double lscale = std::sqrt(opt.smoothing / (3.0 * std::max(M, 1)));
-    for (size_t t = 0; t < terms.size(); ++t) {
-      const int R = terms[t].proj.res;
-      for (int j = 0; j < R; ++j)
-        for (int i = 0; i < R; ++i) {
-          const int u0 = lay[t].unk[j * R + i];
-          if (u0 < 0) continue;
-          std::vector<int> b{u0};
-          std::vector<double> v{0.0};
-          const int nb[4][2] = {{i - 1, j}, {i + 1, j}, {i, j - 1}, {i, j + 1}};
-          for (const auto& q : nb) {
-            if (q[0] < 0 || q[0] >= R || q[1] < 0 || q[1] >= R) continue;
-            const int u = lay[t].unk[q[1] * R + q[0]];
-            if (u < 0) continue;
-            b.push_back(u);
-            v.push_back(-1.0);
-            v[0] += 1.0;
-          }
-          if (b.size() < 2) continue;
-          for (int c = 0; c < 3; ++c) {
-            std::vector<double*> pb;
-            for (int u : b) pb.push_back(at(c, u));
-            problem.AddResidualBlock(new LaplacianCost(v, lscale), nullptr, pb);
-            ++residuals;
-          }
+// Laplacian rows (4-neighbours inside each term's mask), weighted
+// sqrt(smoothing / 3M); returns the number of residuals.
+size_t add_laplacian_residuals(ceres::Problem& problem, const RefineLayout& L, const std::vector<FactorTerm>& terms,
+                               double smoothing, std::vector<double>& y) {
+  const int M = L.M;
+  auto at = [&](int c, int u) { return &y[size_t(c) * M + u]; };
+  size_t residuals = 0;
+  const double lscale = std::sqrt(smoothing / (3.0 * std::max(M, 1)));
+  for (size_t t = 0; t < terms.size(); ++t) {
+    const int R = terms[t].proj.res;
+    for (int j = 0; j < R; ++j)
+      for (int i = 0; i < R; ++i) {
+        const int u0 = L.lay[t].unk[j * R + i];
+        if (u0 < 0) continue;
+        std::vector<int> b{u0};
+        std::vector<double> v{0.0};
+        const int nb[4][2] = {{i - 1, j}, {i + 1, j}, {i, j - 1}, {i, j + 1}};
+        for (const auto& q : nb) {
+          if (q[0] < 0 || q[0] >= R || q[1] < 0 || q[1] >= R) continue;
+          const int u = L.lay[t].unk[q[1] * R + q[0]];
+          if (u < 0) continue;
+          b.push_back(u);
+          v.push_back(-1.0);
+          v[0] += 1.0;
         }
-    }
+        if (b.size() < 2) continue;
+        for (int c = 0; c < 3; ++c) {
+          std::vector<double*> pb;
+          for (int u : b) pb.push_back(at(c, u));
+          problem.AddResidualBlock(new LaplacianCost(v, lscale), nullptr, pb);
+          ++residuals;
+        }
+      }
   }
+  return residuals;
+}
+
+}  // namespace
+
+std::shared_ptr<HomomorphicFactorization> refine(const HomomorphicFactorization& start,
+                                                 const SampleSet& samples,
+                                                 const RefineOptions& opt, RefineReport* report) {
+  const auto t0 = std::chrono::steady_clock::now();
+  opt.validate();
+  const Objective obj = detail::parse_refine_objective(opt.objective);
+  if (start.terms().empty()) throw std::invalid_argument("refine: the start has no terms");
+
+  // Terms: projections (direct and conjugate), masks extended by every texel a
+  // sample reads, and the texel -> unknown map.
+  std::vector<FactorTerm> terms = start.terms();
+  const RefineLayout L = refine_layout(terms, samples);
+  const int M = L.M;
+
+  // Parameters: one double (log texel) per unknown and channel, from the start;
+  // channel c of unknown u is y[c * M + u].
+  std::vector<double> y(size_t(3) * M);
+  auto at = [&](int c, int u) { return &y[size_t(c) * M + u]; };
+  for (size_t t = 0; t < terms.size(); ++t)
+    for (size_t i = 0; i < terms[t].mask.size(); ++i)
+      if (L.lay[t].unk[i] >= 0)
+        for (int c = 0; c < 3; ++c) *at(c, L.lay[t].unk[i]) = terms[t].texels[c][i];
+
+  ceres::Problem problem;
+  size_t residuals = add_sample_residuals(problem, L, terms, samples, start, obj, opt.blend_weight, y);
+  if (opt.smoothing > 0.0) residuals += add_laplacian_residuals(problem, L, terms, opt.smoothing, y);
 
   ceres::Solver::Options so;
   so.minimizer_type = ceres::TRUST_REGION;
@@ -328,7 +365,7 @@ std::shared_ptr<HomomorphicFactorization> refine(const HomomorphicFactorization&
     for (size_t i = 0; i < terms[t].mask.size(); ++i)
       for (int c = 0; c < 3; ++c)
         terms[t].texels[c][i] =
-            lay[t].unk[i] >= 0 ? static_cast<float>(*at(c, lay[t].unk[i])) : 0.0f;
+            L.lay[t].unk[i] >= 0 ? static_cast<float>(*at(c, L.lay[t].unk[i])) : 0.0f;
 
   auto out = std::make_shared<HomomorphicFactorization>(
       std::move(terms), start.A(), start.eps(), start.subtract_eps(),
@@ -344,7 +381,7 @@ std::shared_ptr<HomomorphicFactorization> refine(const HomomorphicFactorization&
         summary.message;
     report->parameters = size_t(3) * M;
     report->residuals = residuals;
-    report->texels_added = added;
+    report->texels_added = L.added;
     report->seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   }

@@ -62,10 +62,6 @@
 #include "brdfs/sampleset.h"
 #include "factor/homomorphic.h"
 
-namespace ceres {
-class CostFunction;
-}
-
 namespace bf {
 
 struct RefineOptions {
@@ -112,22 +108,5 @@ std::shared_ptr<HomomorphicFactorization> refine(const HomomorphicFactorization&
                                                  const SampleSet& samples,
                                                  const RefineOptions& opt,
                                                  RefineReport* report = nullptr);
-
-namespace detail {
-// The residual block of one sample and channel in refine(), exposed for the
-// GradientChecker test: `weights` are the merged stencil weights of the
-// distinct texels (one 1-double parameter block each: the texel's log value in
-// this channel), f the sample's value in the channel, sw = sqrt(w_k / 3W), cosw
-// the cosine factor (1 unless objective "cosine"), A the channel's constant,
-// scale the unit of linear residuals (mean of A), eps and subtract_eps as in
-// the factorization. objective "blend" gives 2
-// residuals (log, linear), else 1.
-std::unique_ptr<ceres::CostFunction> make_refine_sample_cost(const std::vector<double>& weights,
-                                                             double f, double sw, double cosw,
-                                                             double A, double scale, double eps,
-                                                             bool subtract_eps,
-                                                             const std::string& objective,
-                                                             double blend_weight);
-}  // namespace detail
 
 }  // namespace bf

@@ -142,6 +142,7 @@ const StressExpectation& StressCase::expectation(const std::string& method) cons
 
 std::vector<std::string> stress_methods() { return {"mccool", "random2", "svd", "svd-log"}; }
 
+// data table
 std::vector<StressCase> stress_cases() {
   const Catalogue& cat = Catalogue::builtin();
   std::vector<StressCase> c;

@@ -20,7 +20,7 @@ mkdir -p "$log_dir"
 # name|file|perl substitution (must change the file; write a '|' in it as \x7c)
 mutations=(
   'transposed-projection|factor/projection.cpp|s/return \(u\.array\(\) \+ 1\.0\)\.matrix\(\) \* \(0\.5 \* \(res - 1\)\);/return (Eigen::Vector2d(u.y(), u.x()).array() + 1.0).matrix() * (0.5 * (res - 1));/'
-  'laplacian-sign|factor/homomorphic_fit.cpp|s/val\[n\] = -1\.0;/val[n] = 1.0;/'
+  'laplacian-sign|factor/fit_internal.h|s/val\[n\] = -1\.0;/val[n] = 1.0;/'
   'texel-off-by-one|factor/projection.cpp|s/const double x = std::clamp\(s\.x\(\), 0\.0, double\(res - 1\)\);/const double x = std::clamp(s.x() + 1.0, 0.0, double(res - 1));/'
   'exr-transpose|factor/export.cpp|s/for \(int c = 0; c < 3; \+\+c\) px\[3 \* k \+ c\] = t\.texels\[c\]\[k\];/for (int c = 0; c < 3; ++c) px[3 * ((k % R) * R + k \/ R) + c] = t.texels[c][k];/; s/const float v = px\[3 \* k \+ c\];/const float v = px[3 * ((k % R) * R + k \/ R) + c];/'
   'reciprocity-conjugate-dropped|factor/homomorphic.cpp|s/for \(int c = 0; c < 3; \+\+c\) s\[c\] \+= t\.lookup\(c, sc\);/(void)sc;/'

@@ -103,6 +103,29 @@ class Structured {
   // side_out, not into the beam.
   std::vector<Config> step(const std::vector<Config>& beam, int j, int n, TermRecord* rec,
                            const Config* side = nullptr, std::vector<Config>* side_out = nullptr);
+  // The pieces of step. A screened start: the config (index into the step's
+  // parents) it extends, the start (term, value at the start), and whether it
+  // was read off the residual's Hessians or guessed (not a random start).
+  struct Cand {
+    size_t b;
+    Start s;
+    bool seed;
+  };
+  using Objectives = std::vector<std::array<std::unique_ptr<TermObjective>, 2>>;
+  static bool distinct(const std::vector<Cand>& cands, const std::vector<size_t>& chosen, size_t i);
+  // Every parent (beam, then the side config at index S) extended by every
+  // start, each evaluated once; obj receives the parents' objectives.
+  std::vector<Cand> screen(const std::vector<Config>& beam, size_t S, int j, int n, Objectives& obj,
+                           TermRecord* rec);
+  // The side config's starts to refine (order: candidates by value).
+  std::vector<size_t> side_starts(const std::vector<Cand>& cands, const std::vector<size_t>& order,
+                                  const std::vector<size_t>& refine, const std::vector<Config>& beam, size_t S,
+                                  const Config& side) const;
+  // The new beam from the refined starts (res, in refine's order) and the
+  // unrefined candidates, each config's schedule run.
+  std::vector<Config> next_beam(const std::vector<Config>& beam, size_t S, const std::vector<Cand>& cands,
+                                const std::vector<size_t>& order, const std::vector<size_t>& refine,
+                                const std::vector<PowellResult>& res, int n, TermRecord* rec);
   // Jacobi sweeps over terms [from, J): each re-searched with the others held.
   // The objective is the schedule with n terms solved jointly.
   // po: Powell's options for the re-searches.
@@ -179,24 +202,19 @@ std::vector<std::pair<Parameterization, PlaneSplit>> Structured::seeds(const std
   return out;
 }
 
-// One step of the beam: every config extended by every screened start; Powell
-// from the `keep` best distinct (config, start) pairs; the new beam is the best
-// refined configs plus the best unrefined seed configs (see the header).
-std::vector<Structured::Config> Structured::step(const std::vector<Config>& beam_in, int j, int n, TermRecord* rec,
-                                                 const Config* side, std::vector<Config>* side_out) {
-  const double t0 = now_seconds();
-  // The parents: the beam, then the side configuration (index S) if any.
-  const size_t S = beam_in.size();
-  std::vector<Config> beam = beam_in;
-  if (side) beam.push_back(*side);
-  struct Cand {
-    size_t b;      // beam config extended
-    Start s;       // the start (term, value at the start)
-    bool seed;     // read off the residual's Hessians, or a guess (not a random start)
-  };
+// Whether candidate i is finite and not within 0.02 (plane distance) of a
+// chosen candidate extending the same config in the same parameterization.
+bool Structured::distinct(const std::vector<Cand>& cands, const std::vector<size_t>& chosen, size_t i) {
+  for (size_t k : chosen)
+    if (cands[k].b == cands[i].b && cands[k].s.t.p == cands[i].s.t.p &&
+        plane_distance(cands[k].s.t.R, cands[i].s.t.R) < 0.02)
+      return false;
+  return std::isfinite(cands[i].s.value);
+}
+
+std::vector<Structured::Cand> Structured::screen(const std::vector<Config>& beam, size_t S, int j, int n,
+                                                 Objectives& obj, TermRecord* rec) {
   std::vector<Cand> cands;
-  // Objectives per (config, parameterization); built once, shared by threads.
-  std::vector<std::array<std::unique_ptr<TermObjective>, 2>> obj(beam.size());
   // The configs' seed planes, in parallel (independent; results by index).
   std::vector<std::vector<std::pair<Parameterization, PlaneSplit>>> seed_of(beam.size());
   parallel_for(beam.size(), opt_.threads, [&](size_t b) { seed_of[b] = seeds(residual(beam[b].done)); });
@@ -235,77 +253,49 @@ std::vector<Structured::Config> Structured::step(const std::vector<Config>& beam
   });
   evaluations_ += static_cast<int>(cands.size());
   rec->evaluations += static_cast<int>(cands.size());
+  return cands;
+}
 
-  std::vector<size_t> order(cands.size());
-  for (size_t i = 0; i < order.size(); ++i) order[i] = i;
-  std::stable_sort(order.begin(), order.end(),
-                   [&](size_t a, size_t b) { return cands[a].s.value < cands[b].s.value; });
-  const auto distinct = [&](const std::vector<size_t>& chosen, size_t i) {
-    for (size_t k : chosen)
-      if (cands[k].b == cands[i].b && cands[k].s.t.p == cands[i].s.t.p &&
+std::vector<size_t> Structured::side_starts(const std::vector<Cand>& cands, const std::vector<size_t>& order,
+                                            const std::vector<size_t>& refine, const std::vector<Config>& beam,
+                                            size_t S, const Config& side) const {
+  // The side's `keep` Powell runs: the best screened start of each
+  // parameterization, then the best others. A start the beam already refines
+  // from the same configuration counts as run (its result is in the beam).
+  std::vector<size_t> side_refine;
+  size_t twin = S;
+  for (size_t b = 0; b < S && twin == S; ++b) {
+    bool same = beam[b].ts.size() == side.ts.size();
+    for (size_t i = 0; same && i < side.ts.size(); ++i)
+      same = beam[b].ts[i].p == side.ts[i].p && plane_distance(beam[b].ts[i].R, side.ts[i].R) < 1e-9;
+    if (same) twin = b;
+  }
+  std::vector<size_t> covered;  // side starts chosen, run or not
+  const auto choose = [&](size_t i) {
+    if (!distinct(cands, covered, i)) return;
+    covered.push_back(i);
+    for (size_t k : refine)
+      if (cands[k].b == twin && cands[k].s.t.p == cands[i].s.t.p &&
           plane_distance(cands[k].s.t.R, cands[i].s.t.R) < 0.02)
-        return false;
-    return std::isfinite(cands[i].s.value);
+        return;
+    side_refine.push_back(i);
   };
-  std::vector<size_t> refine, side_refine;
-  for (size_t i : order)
-    if (cands[i].b < S && static_cast<int>(refine.size()) < opt_.keep && distinct(refine, i)) refine.push_back(i);
-  if (side) {
-    // The side's `keep` Powell runs: the best screened start of each
-    // parameterization, then the best others. A start the beam already refines
-    // from the same configuration counts as run (its result is in the beam).
-    size_t twin = S;
-    for (size_t b = 0; b < S && twin == S; ++b) {
-      bool same = beam[b].ts.size() == side->ts.size();
-      for (size_t i = 0; same && i < side->ts.size(); ++i)
-        same = beam[b].ts[i].p == side->ts[i].p && plane_distance(beam[b].ts[i].R, side->ts[i].R) < 1e-9;
-      if (same) twin = b;
-    }
-    std::vector<size_t> covered;  // side starts chosen, run or not
-    const auto choose = [&](size_t i) {
-      if (!distinct(covered, i)) return;
-      covered.push_back(i);
-      for (size_t k : refine)
-        if (cands[k].b == twin && cands[k].s.t.p == cands[i].s.t.p &&
-            plane_distance(cands[k].s.t.R, cands[i].s.t.R) < 0.02)
-          return;
-      side_refine.push_back(i);
-    };
-    for (Parameterization p : params_)
-      for (size_t i : order)
-        if (cands[i].b == S && cands[i].s.t.p == p && distinct(covered, i)) {
-          choose(i);
-          break;
-        }
+  for (Parameterization p : params_)
     for (size_t i : order)
-      if (cands[i].b == S && static_cast<int>(covered.size()) < opt_.keep) choose(i);
-  }
-  const size_t nb = refine.size();
-  refine.insert(refine.end(), side_refine.begin(), side_refine.end());
-  std::vector<PowellResult> res(refine.size());
-  parallel_for(refine.size(), opt_.threads, [&](size_t k) {
-    const Cand& c = cands[refine[k]];
-    res[k] = powell_minimize(std::cref(*obj[c.b][pidx(c.s.t.p)]), c.s.t.R, opt_.powell);
-  });
-  for (const PowellResult& r : res) {
-    evaluations_ += r.evaluations;
-    rec->evaluations += r.evaluations;
-  }
-  if (side_out) {
-    side_out->clear();
-    for (size_t k = nb; k < refine.size(); ++k) {
-      Config c;
-      c.ts = side->ts;
-      c.ts.push_back(Term{res[k].best.normalized(), cands[refine[k]].s.t.p});
-      c.value = schedule(c.ts, &c.done, n);
-      c.start = cands[refine[k]].s.index;
-      ++evaluations_;
-      ++rec->evaluations;
-      if (std::isfinite(c.value)) side_out->push_back(std::move(c));
-    }
-  }
-  refine.resize(nb);
-  res.resize(nb);
+      if (cands[i].b == S && cands[i].s.t.p == p && distinct(cands, covered, i)) {
+        choose(i);
+        break;
+      }
+  for (size_t i : order)
+    if (cands[i].b == S && static_cast<int>(covered.size()) < opt_.keep) choose(i);
+  return side_refine;
+}
+
+std::vector<Structured::Config> Structured::next_beam(const std::vector<Config>& beam, size_t S,
+                                                      const std::vector<Cand>& cands,
+                                                      const std::vector<size_t>& order,
+                                                      const std::vector<size_t>& refine,
+                                                      const std::vector<PowellResult>& res, int n, TermRecord* rec) {
   // New beam: refined configs first (best ceil(B/2)), then unrefined seed
   // configs (the planes read off the data, kept even when a single term
   // refined elsewhere fits better: the trap of the greedy search), then
@@ -323,7 +313,7 @@ std::vector<Structured::Config> Structured::step(const std::vector<Config>& beam
   std::stable_sort(refined.begin(), refined.end(), [](const Next& a, const Next& b) { return a.value < b.value; });
   std::vector<size_t> taken_seeds;
   for (size_t i : order) {
-    if (cands[i].b >= S || !distinct(taken_seeds, i)) continue;
+    if (cands[i].b >= S || !distinct(cands, taken_seeds, i)) continue;
     taken_seeds.push_back(i);
     (cands[i].seed ? seeds_next : others).push_back({cands[i].b, cands[i].s.t, cands[i].s.value, cands[i].s.index});
   }
@@ -369,6 +359,59 @@ std::vector<Structured::Config> Structured::step(const std::vector<Config>& beam
     if (std::isfinite(c.value)) out.push_back(std::move(c));
   }
   std::stable_sort(out.begin(), out.end(), [](const Config& a, const Config& b) { return a.value < b.value; });
+  return out;
+}
+
+// One step of the beam: every config extended by every screened start; Powell
+// from the `keep` best distinct (config, start) pairs; the new beam is the best
+// refined configs plus the best unrefined seed configs (see the header).
+std::vector<Structured::Config> Structured::step(const std::vector<Config>& beam_in, int j, int n, TermRecord* rec,
+                                                 const Config* side, std::vector<Config>* side_out) {
+  const double t0 = now_seconds();
+  // The parents: the beam, then the side configuration (index S) if any.
+  const size_t S = beam_in.size();
+  std::vector<Config> beam = beam_in;
+  if (side) beam.push_back(*side);
+  // Objectives per (config, parameterization); built once, shared by threads.
+  Objectives obj(beam.size());
+  const std::vector<Cand> cands = screen(beam, S, j, n, obj, rec);
+
+  std::vector<size_t> order(cands.size());
+  for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(),
+                   [&](size_t a, size_t b) { return cands[a].s.value < cands[b].s.value; });
+  std::vector<size_t> refine, side_refine;
+  for (size_t i : order)
+    if (cands[i].b < S && static_cast<int>(refine.size()) < opt_.keep && distinct(cands, refine, i))
+      refine.push_back(i);
+  if (side) side_refine = side_starts(cands, order, refine, beam, S, *side);
+  const size_t nb = refine.size();
+  refine.insert(refine.end(), side_refine.begin(), side_refine.end());
+  std::vector<PowellResult> res(refine.size());
+  parallel_for(refine.size(), opt_.threads, [&](size_t k) {
+    const Cand& c = cands[refine[k]];
+    res[k] = powell_minimize(std::cref(*obj[c.b][pidx(c.s.t.p)]), c.s.t.R, opt_.powell);
+  });
+  for (const PowellResult& r : res) {
+    evaluations_ += r.evaluations;
+    rec->evaluations += r.evaluations;
+  }
+  if (side_out) {
+    side_out->clear();
+    for (size_t k = nb; k < refine.size(); ++k) {
+      Config c;
+      c.ts = side->ts;
+      c.ts.push_back(Term{res[k].best.normalized(), cands[refine[k]].s.t.p});
+      c.value = schedule(c.ts, &c.done, n);
+      c.start = cands[refine[k]].s.index;
+      ++evaluations_;
+      ++rec->evaluations;
+      if (std::isfinite(c.value)) side_out->push_back(std::move(c));
+    }
+  }
+  refine.resize(nb);
+  res.resize(nb);
+  std::vector<Config> out = next_beam(beam, S, cands, order, refine, res, n, rec);
   rec->seconds += now_seconds() - t0;
   return out;
 }

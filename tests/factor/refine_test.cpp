@@ -10,6 +10,7 @@
 #include "factor/homomorphic_fit.h"
 #include "factor/metrics.h"
 #include "factor/refine.h"
+#include "factor/refine_internal.h"
 #include "fit_helpers.h"
 #include "test_common.h"
 
@@ -56,7 +57,8 @@ TEST_CASE("refine: invalid options name the field, value and rule") {
 TEST_CASE("refine: the analytic Jacobian of a sample residual passes GradientChecker") {
   std::mt19937_64 rng(7);
   std::uniform_real_distribution<double> U(0.0, 1.0);
-  for (const char* objective : {"linear", "cosine", "blend"})
+  using detail::RefineObjective;
+  for (const RefineObjective objective : {RefineObjective::Linear, RefineObjective::Cosine, RefineObjective::Blend})
     for (bool subtract_eps : {true, false})
       for (int trial = 0; trial < 4; ++trial) {
         // A stencil of 4..12 distinct texels with positive weights.
@@ -70,7 +72,7 @@ TEST_CASE("refine: the analytic Jacobian of a sample residual passes GradientChe
         const auto cost = detail::make_refine_sample_cost(
             w, f, 0.01 + U(rng), 0.2 + 0.8 * U(rng), 0.5 + U(rng), 0.7, eps, subtract_eps,
             objective, 0.1 + U(rng));
-        REQUIRE(cost->num_residuals() == (std::string(objective) == "blend" ? 2 : 1));
+        REQUIRE(cost->num_residuals() == (objective == RefineObjective::Blend ? 2 : 1));
         std::vector<const double*> params;
         for (double& x : y) params.push_back(&x);
         ceres::NumericDiffOptions nd;
@@ -80,7 +82,7 @@ TEST_CASE("refine: the analytic Jacobian of a sample residual passes GradientChe
         // offset allocator (CMakeLists.txt, BRDF_FACTOR_NATIVE), which would
         // free a wrong pointer: there the results are deliberately leaked.
         auto* res = new ceres::GradientChecker::ProbeResults;
-        INFO(objective << " subtract_eps=" << subtract_eps << " trial " << trial);
+        INFO("objective " << static_cast<int>(objective) << " subtract_eps=" << subtract_eps << " trial " << trial);
         const bool ok = checker.Probe(params.data(), 1e-6, res);
         INFO(res->error_log);
         CHECK(ok);

@@ -9,7 +9,9 @@
 
 #include "brdfs/sampleset.h"
 #include "factor/homomorphic_fit.h"
+#include "factor/solver_choice.h"
 #include "fit_helpers.h"
+#include "sparse_reference.h"
 #include "test_common.h"
 
 using namespace bf;
@@ -144,7 +146,7 @@ TEST_CASE("sparse fit: Auto takes the dense path up to 1,650 unknowns and the sp
   for (const int res : {8, 40}) {  // a few hundred unknowns; above 1,650 with two 40 x 40 textures
     const JointSolution sol = solve_joint(d, zero, planted_terms(rng, res), opt, false);
     INFO("texture " << res << ": " << sol.unknowns << " unknowns");
-    CHECK(sol.solver == (sol.unknowns <= 1650 ? FitOptions::Solver::Dense : FitOptions::Solver::Sparse));
+    CHECK(sol.solver == (sol.unknowns <= kDenseMaxUnknowns ? FitOptions::Solver::Dense : FitOptions::Solver::Sparse));
   }
 }
 
@@ -167,8 +169,8 @@ TEST_CASE("sparse fit: the column-by-column assembly equals the triplet assembly
     FitOptions opt;
     opt.extrapolation_prior = layout % 2 == 1 ? 0.5 : 0.0;
     const FitData d(s, opt.eps);
-    const SparseNormal ref = sparse_normal_equations(d, joint, opt, /*reference=*/true);
-    const SparseNormal col = sparse_normal_equations(d, joint, opt, /*reference=*/false);
+    const SparseNormal ref = bf_test::reference_sparse_normal_equations(d, joint, opt);
+    const SparseNormal col = sparse_normal_equations(d, joint, opt);
     INFO("layout " << layout << ": " << n << " terms, " << ref.M << " unknowns, prior "
                    << opt.extrapolation_prior);
     REQUIRE(col.M == ref.M);
