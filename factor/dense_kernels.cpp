@@ -65,10 +65,10 @@ const Variant& find(const std::string& name) {
 }
 
 // The chosen variant: BRDF_FACTOR_KERNEL if set, else avx2 where supported,
-// else generic. avx512 is not the default: on the AMD EPYC (Zen 4) this was
-// measured on, Eigen's AVX-512 Cholesky was no faster than its AVX2 one at 442
-// unknowns and 1.2x slower at 1,640 (docs/speed.md, "Inner loop"). Decided once
-// per process.
+// else generic. avx512 is not the default: Eigen's AVX-512 Cholesky is no
+// faster than its AVX2 one at the sizes a fit solves, and slower at the
+// largest dense ones (docs/speed.md, "Kernel variants"). Decided once per
+// process.
 const Variant& chosen() {
   static const Variant& v = [&]() -> const Variant& {
     if (const char* env = std::getenv("BRDF_FACTOR_KERNEL"); env && *env) {

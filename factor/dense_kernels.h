@@ -8,7 +8,7 @@
 // own copy of Eigen in a renamed namespace, and only plain pointers cross the
 // boundary, so no Eigen template instance (or inline function with a different
 // alignment) compiled with AVX flags can be merged by the linker into code that
-// runs on a machine without AVX (docs/results.md §2 has the story of that trap).
+// runs on a machine without AVX (docs/speed.md, "Kernel variants").
 #pragma once
 
 #include <string>

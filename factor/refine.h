@@ -51,8 +51,8 @@
 // tests/factor/refine_test.cpp).
 // Solver: Levenberg-Marquardt, SPARSE_NORMAL_CHOLESKY with Eigen's sparse
 // Cholesky when Ceres has EIGEN_SPARSE, else SuiteSparse, else CGNR. Cost per
-// iteration is dominated by Ceres forming J^T J (about 0.3-0.5 s on W1:
-// 130k residual blocks of 1x12 Jacobians).
+// iteration is dominated by Ceres forming J^T J (W1 has 130k residual blocks
+// of 1x12 Jacobians).
 #pragma once
 
 #include <memory>

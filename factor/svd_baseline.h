@@ -61,7 +61,7 @@ struct SvdOptions {
   // DiskGrid: texels beyond radius 1 - rim_inset are evaluated at that radius.
   // 0 (default) = half the grid spacing, 1/(res-1): the rim texel takes the
   // BRDF's value in the middle of the outermost ring of cells, the region its
-  // bilinear footprint covers inside the disk. A tiny inset (the old 1e-4,
+  // bilinear footprint covers inside the disk. A tiny inset (such as 1e-4,
   // theta 89.99 deg) tabulates the BRDF at grazing angles no sample set
   // reaches, where models with 1/(cos_i cos_o) (Cook-Torrance) are ~1e7: the
   // linear SVD then spends its terms on those texels and bilinear lookups

@@ -14,10 +14,9 @@ namespace bf {
 using RotationObjective = std::function<double(const Rotation4&)>;
 
 // Brent's final bracket as a fraction of PowellOptions::line_tol. Brent's
-// parabolic steps make a narrow bracket cheap (W1's greedy search: 6,045 fits
-// at the full width, 7,307 at a quarter, 9,598 with the golden section), and
-// at the golden section's width its searches ended worse on more terms
-// (docs/speed.md).
+// parabolic steps make a narrow bracket cheap (fewer fits than the golden
+// section even at a quarter of its width), and at the golden section's width
+// its searches end worse on more terms (docs/speed.md, "The line search").
 constexpr double kBrentBracketFraction = 0.25;
 
 struct PowellOptions {

@@ -655,11 +655,8 @@ void run_bench_extrapolation(const BenchExtrapolationArgs& a) {
     }
   }
 }
-}  // namespace
-
-void add_cmd_bench(CLI::App& app) {
-  auto* bench = app.add_subcommand("bench", "Benchmarks that print JSON lines");
-  bench->require_subcommand(1);
+// "bench fit": one homomorphic fit, timed.
+void add_bench_fit(CLI::App* bench) {
   auto* fit = bench->add_subcommand("fit", "Time the inner-loop homomorphic fit (one core)");
   auto a = std::make_shared<BenchFitArgs>();
   fit->add_option("--brdf", a->brdf, "catalogue name or measured file")->capture_default_str();
@@ -682,7 +679,10 @@ void add_cmd_bench(CLI::App& app) {
                   "also write the joint solve's input (samples, projections, masks) and its rel_mse as JSON "
                   "to this file (scripts/bench-peer.py reads it)");
   fit->callback([a] { run_bench_fit(*a); });
+}
 
+// "bench search": the projection search (greedy, structured or both), timed.
+void add_bench_search(CLI::App* bench) {
   auto* search = bench->add_subcommand("search", "Time the greedy projection search (all cores)");
   auto b = std::make_shared<BenchSearchArgs>();
   search->add_option("--brdf", b->brdf, "catalogue name or measured file")->capture_default_str();
@@ -740,7 +740,10 @@ void add_cmd_bench(CLI::App& app) {
     if (param_given && !term_param_given) b->term_param = "fixed";
     run_bench_search(*b);
   });
+}
 
+// "bench lines": golden section against Brent on the search objective.
+void add_bench_lines(CLI::App* bench) {
   auto* lines = bench->add_subcommand(
       "lines", "Golden section against Brent, line by line, on the first term's search objective");
   auto la = std::make_shared<BenchLinesArgs>();
@@ -757,7 +760,10 @@ void add_cmd_bench(CLI::App& app) {
   lines->add_option("--presweeps", la->presweeps, "golden Powell sweeps from each start before the lines")
       ->capture_default_str();
   lines->callback([la] { run_bench_lines(*la); });
+}
 
+// "bench planted": searches on planted product BRDFs.
+void add_bench_planted(CLI::App* bench) {
   auto* planted = bench->add_subcommand(
       "planted", "Planted product BRDFs: McCool, greedy and structured search, floor (fit at the true projections)");
   auto pa = std::make_shared<BenchPlantedArgs>();
@@ -779,7 +785,10 @@ void add_cmd_bench(CLI::App& app) {
       ->check(CLI::IsMember({"structured", "greedy", "both"}))
       ->capture_default_str();
   planted->callback([pa] { run_bench_planted(*pa); });
+}
 
+// "bench extrapolation": bounded extrapolation of measured BRDFs.
+void add_bench_extrapolation(CLI::App* bench) {
   auto* extrap = bench->add_subcommand(
       "extrapolation",
       "Measured BRDFs fitted on their raw samples (McCool, greedy search wiwo and halfdiff, 2 and 3 textures) "
@@ -795,6 +804,18 @@ void add_cmd_bench(CLI::App& app) {
   extrap->add_option("--priors", ea->priors, "extrapolation_prior values to compare (0 = off)")
       ->capture_default_str();
   extrap->callback([ea] { run_bench_extrapolation(*ea); });
+}
+
+}  // namespace
+
+void add_cmd_bench(CLI::App& app) {
+  auto* bench = app.add_subcommand("bench", "Benchmarks that print JSON lines");
+  bench->require_subcommand(1);
+  add_bench_fit(bench);
+  add_bench_search(bench);
+  add_bench_lines(bench);
+  add_bench_planted(bench);
+  add_bench_extrapolation(bench);
 }
 
 }  // namespace bf

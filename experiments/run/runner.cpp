@@ -293,6 +293,46 @@ struct PoolEnd {
   bool abandon = false;
 };
 
+// The state of execute_in_parallel's pool; it outlives the call when workers
+// are abandoned (detached).
+struct PoolState {
+  RenderCache renders;
+  std::mutex mu;
+  std::condition_variable cv;
+  int free_slots = 0;
+  size_t next = 0, done = 0;
+  int busy = 0, exited = 0;  // workers inside a run; workers that returned
+  bool closed = false;       // the snapshot of finished runs is taken: no run finishes after it
+  std::vector<RunEntry> entries;
+};
+
+// The failed row of run r (its folder removed).
+RunEntry failed_entry(const Plan& plan, const PlannedRun& r, const fs::path& exp_dir, const std::exception& ex) {
+  std::error_code ec;
+  fs::remove_all(exp_dir / "runs" / r.run_id, ec);
+  RunEntry f;
+  f.run_id = r.run_id;
+  f.status = "failed";
+  set_presentation(f.row, plan, r);
+  f.row["status"] = "failed";
+  const bool oom = dynamic_cast<const std::bad_alloc*>(&ex) != nullptr;  // never "std::bad_alloc" alone
+  f.row["notes"] = std::string("failed: ") + (oom ? "out of memory" : ex.what());
+  f.record = {{"run_id", r.run_id}, {"error", ex.what()}, {"method", plan.methods[r.method].options}};
+  return f;
+}
+
+// The progress line of a finished run e (done of total, t0 its start, start the pool's).
+void print_run_end(std::ostream& err, RunEntry& e, const std::string& run_id, size_t done, size_t total,
+                   Clock::time_point t0, Clock::time_point start) {
+  const double el = since(start);
+  const double eta = done < total ? el / done * (total - done) : 0.0;
+  err << "[" << done << "/" << total << "] " << (e.status == "ok" ? "done " : "FAILED ") << run_id << " in "
+      << std::fixed << std::setprecision(1) << since(t0) << std::defaultfloat << " s";
+  if (e.status == "ok") err << ", rel_mse " << e.row["rel_mse"];
+  else err << ": " << e.row["notes"];
+  err << " | elapsed " << hms(el) << ", eta " << hms(eta) << "\n";
+}
+
 // Executes the runs `todo` (plan indices, plan order) on `jobs` slots: each
 // run holds min(jobs, its method's cores) slots (runner.h), progress on err.
 // A signal (experiments/run/interrupt.h) stops taking new runs; entries then
@@ -302,17 +342,7 @@ PoolEnd execute_in_parallel(const Plan& plan, const std::vector<size_t>& todo, i
                             const std::vector<std::vector<std::string>>& run_notes, const fs::path& exp_dir,
                             const json& build, const RunOptions& opt, std::ostream& err,
                             std::vector<RunEntry>& entries) {
-  // The pool's state outlives this call when workers are abandoned (detached).
-  struct State {
-    RenderCache renders;
-    std::mutex mu;
-    std::condition_variable cv;
-    int free_slots = 0;
-    size_t next = 0, done = 0;
-    int busy = 0, exited = 0;  // workers inside a run; workers that returned
-    bool closed = false;       // the snapshot of finished runs is taken: no run finishes after it
-    std::vector<RunEntry> entries;
-  };
+  using State = PoolState;
   auto st = std::make_shared<State>();
   st->free_slots = jobs;
   st->entries = entries;
@@ -343,20 +373,7 @@ PoolEnd execute_in_parallel(const Plan& plan, const std::vector<size_t>& todo, i
       const PlannedRun& r = plan.runs[i];
       const auto t0 = Clock::now();
       RunEntry e;
-      // The failed row of run r (its folder removed).
-      auto failed = [&](const std::exception& ex) {
-        std::error_code ec;
-        fs::remove_all(exp_dir / "runs" / r.run_id, ec);
-        RunEntry f;
-        f.run_id = r.run_id;
-        f.status = "failed";
-        set_presentation(f.row, plan, r);
-        f.row["status"] = "failed";
-        const bool oom = dynamic_cast<const std::bad_alloc*>(&ex) != nullptr;  // never "std::bad_alloc" alone
-        f.row["notes"] = std::string("failed: ") + (oom ? "out of memory" : ex.what());
-        f.record = {{"run_id", r.run_id}, {"error", ex.what()}, {"method", plan.methods[r.method].options}};
-        return f;
-      };
+      auto failed = [&](const std::exception& ex) { return failed_entry(plan, r, exp_dir, ex); };
       std::string marker;  // the DONE marker of a run whose files are written
       try {
         e = execute_run(plan, r, *samples.at(r.samples_key), exp_dir, s.renders, build, run_notes[i]);
@@ -388,16 +405,7 @@ PoolEnd execute_in_parallel(const Plan& plan, const std::vector<size_t>& todo, i
         s.free_slots += w;
         --s.busy;
         ++s.done;
-        if (!opt.quiet && !too_late) {
-          const double el = since(start);
-          const double eta = s.done < total ? el / s.done * (total - s.done) : 0.0;
-          err << "[" << s.done << "/" << total << "] " << (s.entries[i].status == "ok" ? "done " : "FAILED ")
-              << r.run_id << " in " << std::fixed << std::setprecision(1) << since(t0) << std::defaultfloat
-              << " s";
-          if (s.entries[i].status == "ok") err << ", rel_mse " << s.entries[i].row["rel_mse"];
-          else err << ": " << s.entries[i].row["notes"];
-          err << " | elapsed " << hms(el) << ", eta " << hms(eta) << "\n";
-        }
+        if (!opt.quiet && !too_late) print_run_end(err, s.entries[i], r.run_id, s.done, total, t0, start);
       }
       s.cv.notify_all();
     }
@@ -530,6 +538,39 @@ std::vector<Action> decide_actions(const Plan& plan, const fs::path& exp_dir, co
   return action;
 }
 
+// The line saying what this run of the experiment will do (runs to do and
+// cached, those redone and not trusted, job slots, folder).
+void print_start(const Plan& plan, const std::vector<Action>& action, const std::vector<std::string>& untrusted,
+                 const RunSummary& sum, const RunOptions& opt, size_t n_run, size_t n_cached, int jobs,
+                 const std::string& dir, std::ostream& err) {
+  err << "experiment " << plan.experiment.name << ": " << sum.in_shard << " runs";
+  if (opt.shards > 1) err << " in shard " << opt.shard << "/" << opt.shards << " (of " << plan.runs.size() << ")";
+  err << ": " << n_run << " to do, " << n_cached << " cached";
+  size_t redo = 0, untrusted_runs = 0;
+  for (size_t i = 0; i < action.size(); ++i) {
+    redo += action[i] == Action::Redo;
+    untrusted_runs += !untrusted[i].empty();
+  }
+  if (redo)
+    err << " (" << redo << " unfinished"
+        << (untrusted_runs ? ", " + std::to_string(untrusted_runs) + " of them not trusted" : std::string())
+        << ", redone)";
+  err << "; " << jobs << " job slot" << (jobs > 1 ? "s" : "") << " -> " << dir << "\n";
+}
+
+// What was found wrong with the caches each run would have used (its notes):
+// an untrusted finished run (by plan index), rebuilt samples (by sample key).
+std::vector<std::vector<std::string>> cache_notes(const Plan& plan, const std::vector<std::string>& untrusted,
+                                                  const std::map<std::string, std::string>& rebuilt) {
+  std::vector<std::vector<std::string>> run_notes(plan.runs.size());
+  for (size_t i = 0; i < plan.runs.size(); ++i) {
+    if (!untrusted[i].empty()) run_notes[i].push_back("redone: " + untrusted[i] + " (not trusted)");
+    if (auto it = rebuilt.find(plan.runs[i].samples_key); it != rebuilt.end())
+      run_notes[i].push_back("samples rebuilt: " + it->second + " (not trusted)");
+  }
+  return run_notes;
+}
+
 // Marks the runs a signal stopped before they finished; returns their count.
 size_t mark_interrupted(const Plan& plan, const std::vector<size_t>& todo, int stopped_by, int shard,
                         std::vector<RunEntry>& entries) {
@@ -631,32 +672,12 @@ RunSummary run_experiment(const RunOptions& opt, std::ostream& out, std::ostream
   fs::create_directories(exp_dir / "runs");
   const int jobs_cfg = opt.jobs >= 0 ? opt.jobs : plan.experiment.jobs;
   const int jobs = hardware_threads(jobs_cfg);
-  if (!opt.quiet) {
-    err << "experiment " << plan.experiment.name << ": " << sum.in_shard << " runs";
-    if (opt.shards > 1) err << " in shard " << opt.shard << "/" << opt.shards << " (of " << plan.runs.size() << ")";
-    err << ": " << n_run << " to do, " << n_cached << " cached";
-    size_t redo = 0, untrusted_runs = 0;
-    for (size_t i = 0; i < action.size(); ++i) {
-      redo += action[i] == Action::Redo;
-      untrusted_runs += !untrusted[i].empty();
-    }
-    if (redo)
-      err << " (" << redo << " unfinished"
-          << (untrusted_runs ? ", " + std::to_string(untrusted_runs) + " of them not trusted" : std::string())
-          << ", redone)";
-    err << "; " << jobs << " job slot" << (jobs > 1 ? "s" : "") << " -> " << dir << "\n";
-  }
+  if (!opt.quiet) print_start(plan, action, untrusted, sum, opt, n_run, n_cached, jobs, dir, err);
 
   // Samples for the runs to do.
   std::map<std::string, std::string> rebuilt;
   const auto samples = prepare_samples(plan, action, exp_dir, opt, err, rebuilt);
-  // What was found wrong with the caches each run would have used (its notes).
-  std::vector<std::vector<std::string>> run_notes(plan.runs.size());
-  for (size_t i = 0; i < plan.runs.size(); ++i) {
-    if (!untrusted[i].empty()) run_notes[i].push_back("redone: " + untrusted[i] + " (not trusted)");
-    if (auto it = rebuilt.find(plan.runs[i].samples_key); it != rebuilt.end())
-      run_notes[i].push_back("samples rebuilt: " + it->second + " (not trusted)");
-  }
+  const std::vector<std::vector<std::string>> run_notes = cache_notes(plan, untrusted, rebuilt);
 
   // Execute.
   std::vector<RunEntry> entries(plan.runs.size());

@@ -1,4 +1,4 @@
-// Hostile input, round two (docs/robustness.md): files that name files, and
+// Hostile input (docs/robustness.md, "Promises and the tests that check them"): files that name files, and
 // the readers' bounds. Every case runs the real CLI and expects exit 2 with
 // one message naming the offending file, never a crash.
 #include <sys/stat.h>
