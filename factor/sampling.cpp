@@ -2,6 +2,7 @@
 // the Cook-Torrance model's own sampler, cosine sampling. docs/design.md,
 // "Importance sampling".
 #include "factor/sampling.h"
+#include "factor/sampling_export.h"
 
 #include <algorithm>
 #include <cmath>
@@ -312,6 +313,10 @@ std::shared_ptr<const BrdfSampler> make_sampler(const Brdf& f, const SamplerOpti
       rc[T] = 1.0f;
     }
   }
+  return std::make_shared<TabulatedSampler>(std::move(t));
+}
+
+std::shared_ptr<const BrdfSampler> tabulated_sampler(SamplerTable t) {
   return std::make_shared<TabulatedSampler>(std::move(t));
 }
 
