@@ -71,7 +71,7 @@ TEST_CASE("sampling: every kind's sampler passes chi2 on bluepaint") {
   check_every_kind("preset = \"bluepaint\"", 10000);
 }
 
-TEST_CASE("sampling: every kind's sampler passes chi2 on Cook-Torrance and a Cornell paint [slow]", "[slow]") {
+TEST_CASE("sampling: every kind's sampler passes chi2 on Cook-Torrance and a Cornell paint", "[slow]") {
   check_every_kind("preset = \"bluepaint\"", 1000000);
   check_every_kind("model = \"cook-torrance\"\nkd = 0.1\nks = 0.9\nm = 0.2\nf0 = 0.1", 1000000);
   check_every_kind("model = \"krylon-blue\"", 1000000);

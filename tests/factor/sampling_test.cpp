@@ -71,7 +71,7 @@ TEST_CASE("sampling: chi2 passes for the table and the model sampler on three BR
   CHECK(corrected_p(*cosine_sampler(), 20000) > 0.01);
 }
 
-TEST_CASE("sampling: chi2 passes with a million samples per view [slow]", "[slow]") {
+TEST_CASE("sampling: chi2 passes with a million samples per view", "[slow]") {
   for (const char* spec : {kCookTorrance, "bluepaint", "krylon-blue"}) {
     INFO(spec);
     const BrdfPtr f = Catalogue::builtin().make(spec);
