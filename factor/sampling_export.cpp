@@ -67,8 +67,13 @@ SamplerTable sampling_table_from(const FloatImage& img, const nlohmann::json& e,
     throw std::invalid_argument(what + ": expected a " + std::to_string(W1 * t.view_phi_bins) + " x " +
                                 std::to_string((T + 1) * t.view_bins) + " image for the sizes in the sidecar, found " +
                                 std::to_string(img.width) + " x " + std::to_string(img.height));
+  // The value channel: R (EXR files list their channels sorted by name), or a single channel.
   const int ch = img.channels();
-  auto px = [&](int x, int y) { return img.pixels[(static_cast<size_t>(y) * img.width + x) * ch]; };
+  int rc_index = ch == 1 ? 0 : -1;
+  for (int k = 0; k < ch; ++k)
+    if (img.channel_names[k] == "R") rc_index = k;
+  if (rc_index < 0) throw std::invalid_argument(what + ": expected a channel R, found none");
+  auto px = [&](int x, int y) { return img.pixels[(static_cast<size_t>(y) * img.width + x) * ch + rc_index]; };
   const int V = t.view_bins * t.view_phi_bins;
   t.row_cdf.resize(static_cast<size_t>(V) * (T + 1));
   t.col_cdf.resize(static_cast<size_t>(V) * T * (P + 1));
