@@ -78,8 +78,8 @@ class TabulatedSampler final : public BrdfSampler {
     }
     u1 -= m.w_cos;
     int v = m.va;
-    if (u1 >= m.w_a && m.w_b > 0) u1 -= m.w_a, v = m.vb;
-    const double wv = v == m.va ? m.w_a : m.w_b;
+    double wv = m.w_a;
+    if (u1 >= m.w_a && m.w_b > 0) u1 -= m.w_a, v = m.vb, wv = m.w_b;
     u1 = clamp_u(u1 / wv);
     const int T = t_.theta_bins, P = t_.phi_bins;
     const float* rc = &t_.row_cdf[static_cast<size_t>(v) * (T + 1)];
