@@ -34,6 +34,7 @@ bool above(const Vec3& w) { return w.z() > 0 && std::isfinite(w.z()) && std::isf
 
 // The azimuth of w in [0, 2 pi).
 double azimuth(const Vec3& w) {
+  if (w.x() == 0 && w.y() == 0) return 0.0;  // (atan2(-0, -0) is -pi)
   double p = std::atan2(w.y(), w.x());
   if (p < 0) p += kTwoPi;
   return p >= kTwoPi ? 0.0 : p;

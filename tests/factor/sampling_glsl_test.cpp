@@ -73,6 +73,14 @@ TEST_CASE("sampling: exported GLSL sample and pdf compile for four targets and m
       REQUIRE(a.wi == b.wi);
       REQUIRE(a.pdf == b.pdf);
     }
+    {  // The CPU's samples beside the GPU's outputs (kept with BF_KEEP_TMP=1).
+      std::ofstream cpu(tmp.path / "cpu.txt");
+      cpu.precision(9);
+      for (const auto& [u, wo] : pairs) {
+        const DirectionSample d = s->sample(wo, u.x(), u.y());
+        cpu << d.wi.x() << " " << d.wi.y() << " " << d.wi.z() << " " << d.pdf << "\n";
+      }
+    }
     const fs::path gw = tmp.path / "wi.glsl", gp = tmp.path / "pdf.glsl";
     std::ofstream(gw) << glsl << wrapper("return brdf_factor_sample(wo, a.xy).xyz;");
     std::ofstream(gp) << glsl << wrapper("vec4 s = brdf_factor_sample(wo, a.xy);\n"
