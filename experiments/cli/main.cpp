@@ -23,6 +23,7 @@ int main(int argc, char** argv) {
   bf::add_cmd_run(app);
   bf::add_cmd_merge(app);
   bf::add_cmd_stress(app);
+  bf::add_cmd_sample_dirs(app);
   try {
     bf::register_export_loader(bf::Catalogue::global());
     app.parse(argc, argv);

@@ -417,6 +417,8 @@ void read_method(Reader& r, const MethodKind& kind, uint64_t base_seed, MethodVa
     r.fail("refine", "refine = \"" + m.refine + "\" applies to the homomorphic kinds (" +
                          join(refinable_kind_names()) + ") only; kind = \"" + m.kind + "\" needs refine = \"none\"");
   o["refine"] = m.refine;
+  m.sampling = r.boolean(find_key(common_method_keys(), "sampling"), false);
+  if (m.sampling) o["sampling"] = true;  // (absent when false: run ids of configs without it unchanged)
   kind.read(r, m, o, base_seed);
   // One rule for every kind that reads texture_size = "auto".
   if (!m.texture_ladder.empty() && !m.tolerance)

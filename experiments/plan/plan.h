@@ -128,6 +128,7 @@ struct MethodVariant {
   // refine_smoothing fill refine_options).
   std::string refine = "none";
   RefineOptions refine_options;
+  bool sampling = false;  // `sampling` key: build (and export) the importance sampler (experiments/run/sampling_run.h)
   ModelFitOptions model_fit;           // model-fit
   int cap = 0;              // with a tolerance: the largest terms / order tried
   // texture_size = "auto" (mccool, fit, svd; needs a tolerance): the

@@ -51,7 +51,7 @@ const std::vector<std::string>& result_columns() {
                           "flag", "isotropic",
                           "refine", "refine_seconds", "rel_mse_before", "rel_mae_before", "rel_max_before",
                           "lin_rmse_before", "lin_mae_before", "lin_max_before", "cos_rmse_before", "model",
-                          "notes"})
+                          "sampler_storage", "sampler_build_s", "notes"})
       v.push_back(e);
     return v;
   }();

@@ -24,7 +24,8 @@ const std::vector<std::string>& required_columns();
 // shade_rmse, val_rel_mse, val_cos_rmse, val_max_ratio, holdout_rel_mse,
 // holdout_cos_rmse, validation, flag (experiments/report/validation.h), isotropic,
 // refine, refine_seconds, <metric>_before (the 7 metrics of the
-// fit before refinement), model, notes (docs/experiments.md says what each holds).
+// fit before refinement), model, sampler_storage, sampler_build_s
+// (experiments/run/sampling_run.h), notes (docs/experiments.md says what each holds).
 const std::vector<std::string>& result_columns();
 
 // One results row: column -> cell text; a missing column is an empty cell.

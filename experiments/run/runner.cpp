@@ -31,6 +31,7 @@
 #include "experiments/common/cli_util.h"
 #include "experiments/report/render.h"
 #include "experiments/run/sample_cache.h"
+#include "experiments/run/sampling_run.h"
 #include "experiments/run/preflight.h"
 #include "experiments/run/run_folder.h"
 #include "experiments/methods/method_kind.h"
@@ -229,6 +230,7 @@ RunEntry execute_run(const Plan& plan, const PlannedRun& pr, const SampleSet& sa
   }
 
   if (plan.experiment.export_factors) kind.export_files(c, out);
+  if (m.sampling) run_sampling(*out.result, plan.experiment.export_factors, run_dir, row, rec);
   if (plan.experiment.render || plan.scene.shade) {
     const auto original = renders.get(plan, pr.brdf);
     const SphereRender approx = render_sphere(*out.result, plan.scene);

@@ -91,5 +91,6 @@ void bind_samples(py::module_& m);       // samples.cpp: SampleSet and samplers
 void bind_factorization(py::module_& m); // factorization.cpp: Factorization, load, metrics
 void bind_methods(py::module_& m);       // methods.cpp: mccool, fit, search, svd, sh_k, sh_r, model_fit, refine
 void bind_run(py::module_& m);           // run.cpp: run()
+void bind_sampling(py::module_& m);      // sampling.cpp: Brdf.sample, Brdf.pdf
 
 }  // namespace bf::py_module

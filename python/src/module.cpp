@@ -154,6 +154,7 @@ PYBIND11_MODULE(_core, m) {
     }
   });
   bp::bind_catalogue(m);
+  bp::bind_sampling(m);
   bp::bind_samples(m);
   bp::bind_factorization(m);
   bp::bind_methods(m);

@@ -1,0 +1,22 @@
+// `[[method]] sampling = true`: the importance sampler of a run's result
+// (factor/sampling.h, default SamplerOptions), its columns sampler_storage
+// (floats a renderer holds to sample) and sampler_build_s (seconds to build
+// it), its run.json entry "sampling", and with export on its files in the run
+// folder: sampling.exr (the table), sampling.glsl (brdf_factor_sample,
+// brdf_factor_pdf) and sampling.json (the sidecar entry; docs/design.md,
+// "Importance sampling"). The exported sampler is always the table (the
+// GLSL reads it), also where make_sampler would pick a model's own sampler.
+#pragma once
+
+#include <filesystem>
+#include <nlohmann/json.hpp>
+
+#include "brdfs/brdf.h"
+#include "experiments/report/outputs.h"
+
+namespace bf {
+
+void run_sampling(const Brdf& result, bool export_files, const std::filesystem::path& run_dir, Row& row,
+                  nlohmann::json& record);
+
+}  // namespace bf
