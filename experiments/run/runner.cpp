@@ -75,6 +75,8 @@ std::string describe_method(const MethodVariant& m) {
     }
   if (m.tolerance) s += " tolerance=" + m.tolerance->metric + "<=" + format_number(m.tolerance->value);
   if (m.refine != "none") s += " refine=" + m.refine;
+  if (const auto wf = m.options.find("weight_fit"); wf != m.options.end())
+    s += " weight_fit=" + wf->at("rule").get<std::string>() + " weight_floor=" + format_number(wf->at("floor").get<double>());
   return s;
 }
 
