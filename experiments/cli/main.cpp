@@ -10,6 +10,10 @@
 #include "experiments/run/interrupt.h"
 #include "factor/export.h"
 
+namespace bf {
+void add_cmd_mc_variance(CLI::App& app);  // cmd_mc_variance.cpp
+}
+
 int main(int argc, char** argv) {
   CLI::App app{"brdf-factor: BRDF factorization toolkit (homomorphic fits, projection search, "
                "SVD and SH baselines)"};
@@ -24,6 +28,7 @@ int main(int argc, char** argv) {
   bf::add_cmd_merge(app);
   bf::add_cmd_stress(app);
   bf::add_cmd_sample_dirs(app);
+  bf::add_cmd_mc_variance(app);
   try {
     bf::register_export_loader(bf::Catalogue::global());
     app.parse(argc, argv);

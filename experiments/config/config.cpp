@@ -419,6 +419,15 @@ void read_method(Reader& r, const MethodKind& kind, uint64_t base_seed, MethodVa
   o["refine"] = m.refine;
   m.sampling = r.boolean(find_key(common_method_keys(), "sampling"), false);
   if (m.sampling) o["sampling"] = true;  // (absent when false: run ids of configs without it unchanged)
+  // Scene-weighted fits (experiments/report/scene_weights.h): in the options,
+  // hence the run id, only when asked for.
+  const std::string weight_fit = r.choice(find_key(common_method_keys(), "weight_fit"), "none");
+  const bool has_floor = r.has("weight_floor");
+  const double weight_floor = r.number(find_key(common_method_keys(), "weight_floor"), 0.1);
+  if (weight_fit != "none") o["weight_fit"] = {{"rule", weight_fit}, {"floor", weight_floor}};
+  else if (has_floor)
+    r.fail("weight_floor", "weight_floor is the floor of the image weights, but weight_fit is \"none\": set "
+                           "weight_fit = \"image\" or remove weight_floor");
   kind.read(r, m, o, base_seed);
   // One rule for every kind that reads texture_size = "auto".
   if (!m.texture_ladder.empty() && !m.tolerance)

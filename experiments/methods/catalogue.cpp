@@ -94,6 +94,12 @@ const std::vector<KeySpec>& common_method_keys() {
                "also build the importance sampler of the result (`factor/sampling.h`, default options): columns "
                "`sampler_storage` and `sampler_build_s`; with `export`, `sampling.exr`, `sampling.glsl` and "
                "`sampling.json` in the run folder (docs/design.md, Importance sampling)"),
+      choice_key("weight_fit", {"none", "image"}, "none",
+                 "`image`: the samples this method fits are weighted by how much the (wi, wo) pairs near them "
+                 "contribute to the `[scene]`'s image (rule: design.md §4.2); the row gains `scene_rel_mse`, "
+                 "`rel_mse` stays unweighted. `none`: the samples' own weights (the run id is unchanged)"),
+      num_key("weight_floor", 0.0, 1.0, false, "0.1",
+              "with `weight_fit = \"image\"` only: every sample keeps at least this fraction of the mean weight"),
       other_key("zip", "list of keys", "", "see [Zip](#zip)")};
   return keys;
 }

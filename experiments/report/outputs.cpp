@@ -46,8 +46,8 @@ const std::vector<std::string>& result_columns() {
     std::vector<std::string> v = required_columns();
     for (const char* e : {"label", "sampling", "sweep", "seed", "status", "errors_after_term",
                           "search_strategy", "term_parameterizations", "negative_texels",
-                          "order", "view_order", "tolerance", "tolerance_reached", "shade_rmse", "val_rel_mse",
-                          "val_cos_rmse", "val_max_ratio", "holdout_rel_mse", "holdout_cos_rmse", "validation",
+                          "order", "view_order", "tolerance", "tolerance_reached", "shade_rmse", "scene_rel_mse",
+                          "val_rel_mse", "val_cos_rmse", "val_max_ratio", "holdout_rel_mse", "holdout_cos_rmse", "validation",
                           "flag", "isotropic",
                           "refine", "refine_seconds", "rel_mse_before", "rel_mae_before", "rel_max_before",
                           "lin_rmse_before", "lin_mae_before", "lin_max_before", "cos_rmse_before", "model",
@@ -61,8 +61,8 @@ const std::vector<std::string>& result_columns() {
 std::vector<std::string> display_columns(const std::vector<RunEntry>& runs) {
   std::vector<std::string> cols = required_columns();
   cols.insert(cols.begin() + 3, "label");
-  for (const char* extra : {"search_strategy", "term_parameterizations", "order", "view_order", "tolerance", "tolerance_reached", "shade_rmse", "val_rel_mse",
-                            "val_cos_rmse", "val_max_ratio", "holdout_rel_mse", "holdout_cos_rmse", "flag", "refine",
+  for (const char* extra : {"search_strategy", "term_parameterizations", "order", "view_order", "tolerance", "tolerance_reached", "shade_rmse", "scene_rel_mse",
+                            "val_rel_mse", "val_cos_rmse", "val_max_ratio", "holdout_rel_mse", "holdout_cos_rmse", "flag", "refine",
                             "refine_seconds", "rel_mse_before", "lin_rmse_before", "cos_rmse_before", "seed",
                             "sampling", "sweep", "model", "notes"})
     for (const auto& r : runs) {

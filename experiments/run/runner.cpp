@@ -30,6 +30,7 @@
 #include "brdfs/sampleset.h"
 #include "experiments/common/cli_util.h"
 #include "experiments/report/render.h"
+#include "experiments/report/scene_weights.h"
 #include "experiments/run/sample_cache.h"
 #include "experiments/run/sampling_run.h"
 #include "experiments/run/preflight.h"
@@ -75,6 +76,8 @@ std::string describe_method(const MethodVariant& m) {
     }
   if (m.tolerance) s += " tolerance=" + m.tolerance->metric + "<=" + format_number(m.tolerance->value);
   if (m.refine != "none") s += " refine=" + m.refine;
+  if (const auto wf = m.options.find("weight_fit"); wf != m.options.end())
+    s += " weight_fit=" + wf->at("rule").get<std::string>() + " weight_floor=" + format_number(wf->at("floor").get<double>());
   return s;
 }
 
@@ -205,13 +208,19 @@ RunEntry execute_run(const Plan& plan, const PlannedRun& pr, const SampleSet& sa
   row["isotropic"] = isotropy.isotropic ? "true" : "false";
   rec["isotropy"] = isotropy.describe();
 
-  const RunContext c{plan, pr, b, m, fit_samples, lt, isotropy, run_dir,
+  // Scene-weighted fits (experiments/report/scene_weights.h): the kind fits the
+  // weighted samples; rel_mse and the other metrics stay unweighted.
+  std::optional<SampleSet> weighted;
+  if (const auto wf = m.options.find("weight_fit"); wf != m.options.end())
+    weighted = scene_weighted(fit_samples, scene_pairs(*b.brdf, plan.scene), wf->at("floor").get<double>());
+  const RunContext c{plan, pr, b, m, weighted ? *weighted : fit_samples, lt, isotropy, run_dir,
                      [&] { return renders.get(plan, pr.brdf); }};
   const auto t0 = Clock::now();
   MethodOutcome out = kind.run(c);
   const double seconds = since(t0);
   if (!out.result) throw std::runtime_error("method " + m.kind + " returned no factorization");
   const Metrics mt = evaluate_metrics(*out.result, fit_samples, lt);
+  if (weighted) row["scene_rel_mse"] = format_number(evaluate_metrics(*out.result, *weighted, lt).rel_mse);
 
   // The kind's columns (the required ones empty unless it fills them), then the common ones.
   for (const char* k : {"parameterization", "reciprocity", "terms", "texture_size"}) row[k] = "";
