@@ -217,11 +217,15 @@ std::string viewer_section(const std::vector<ViewerRun>& runs) {
   // Inside a <script> element: no "</script", "<!--" or "<script" (escape.h).
   const std::string text = script_json(list);
   // Test mode writes every viewer.js in while the page is parsed (so the
-  // numbers exist when the page has loaded); otherwise each is loaded when its
-  // run is shown. (The attribute is spelled in pieces: this is page text.)
+  // numbers exist when the page has loaded), "?viewer[=ID]" the run it opens
+  // (and the first, its fallback: drawn before a headless screenshot is
+  // taken); otherwise each is loaded when its run is shown. (The attribute is
+  // spelled in pieces: this is page text.)
   h << "<script>window.BF_VIEWER_FILES = " << text << ";\n"
-    << "if (location.hash === \"#viewer-test\") for (const f of window.BF_VIEWER_FILES) "
-       "document.write(\"<scr\" + \"ipt s\" + \"rc='\" + f.path + \"'></scr\" + \"ipt>\");</script>\n";
+    << "{const q = new URLSearchParams(location.search);\n"
+       "for (const [i, f] of window.BF_VIEWER_FILES.entries()) if (location.hash === \"#viewer-test\" || "
+       "(q.has(\"viewer\") && (i === 0 || f.id === q.get(\"viewer\")))) "
+       "document.write(\"<scr\" + \"ipt s\" + \"rc='\" + f.path + \"'></scr\" + \"ipt>\");}</script>\n";
   h << "<script>" << kViewerScript << "</script>\n</div>\n";
   return h.str();
 }

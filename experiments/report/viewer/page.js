@@ -320,9 +320,20 @@ if (testMode) {
   $("viewer-test").textContent = out.join("\n");
 }
 // "#viewer=<run_id>" opens that run and scrolls to the viewer.
-const wanted = location.hash.startsWith("#viewer=") ? location.hash.slice(8) : "";
+// "?viewer=<run_id>" ("?viewer": the first run) opens it with the page above
+// the viewer hidden, so the viewer is at the top unscrolled: headless
+// screenshots come out blank once the page has scrolled.
+const query = new URLSearchParams(location.search);
+const wanted = location.hash.startsWith("#viewer=") ? location.hash.slice(8) : query.get("viewer") || "";
 show(ids.includes(wanted) ? wanted : ids[0]);
-if (location.hash.startsWith("#viewer")) $("viewer-h").scrollIntoView();
+if (query.has("viewer")) {
+  for (const el of Array.from(document.body.children)) {
+    if (el.id === "viewer-h") break;
+    el.style.display = "none";
+  }
+} else if (location.hash.startsWith("#viewer")) {
+  $("viewer-h").scrollIntoView();
+}
 if (testMode) {
   // A drag through the real handlers (the first run, shown above): pointer
   // down and up at (x, y) = (0.3, 0.4) of the original sphere's half-width
