@@ -135,7 +135,7 @@ function bar(cv, label, lo, hi, ramp, log) {
   ctx.textAlign = "center"; ctx.fillText(label, w / 2, 40);
 }
 const state = {id: null, light: null, cam: [1, 0, 0, 0, 1, 0, 0, 0, 1], yaw: 0, pitch: 0, exposure: 1,
-               theta_i: 30 * Math.PI / 180, phi_d: Math.PI / 2, env: true};
+               theta_i: 30 * Math.PI / 180, phi_d: Math.PI / 2, env: true, channel: "mean", log: true};
 const $ = (q) => document.getElementById(q);
 function camMatrix() {
   const cy = Math.cos(state.yaw), sy = Math.sin(state.yaw), cp = Math.cos(state.pitch), sp = Math.sin(state.pitch);
@@ -188,17 +188,22 @@ function draw() {
   });
   bar($("v-bar-rad"), "radiance (white)", 0, 1 / expo, (t) => [srgb(t), srgb(t), srgb(t)], false);
   bar($("v-bar-diff"), "|difference|", 0, 0.25 / expo, heat, false);
-  // theta_h - theta_d slices, log colour over 4 decades below the original's peak.
+  // theta_h - theta_d slices at the phi_d slider: the chosen channel (or the
+  // mean of R, G, B), log colour over 4 decades below the original's peak or
+  // linear from 0 to it.
   const m = 90;
   const S0 = run(id, 1, 0, m, m, u), S1 = run(id, 1, 1, m, m, u);
+  const value = (S, k) => state.channel === "mean" ? (S[4 * k] + S[4 * k + 1] + S[4 * k + 2]) / 3
+                                                   : S[4 * k + Number(state.channel)];
   let peak = 0;
-  for (let k = 0; k < m * m; ++k) peak = Math.max(peak, (S0[4 * k] + S0[4 * k + 1] + S0[4 * k + 2]) / 3);
+  for (let k = 0; k < m * m; ++k) peak = Math.max(peak, value(S0, k));
   peak = peak > 0 ? peak : 1;
-  const lo = peak * 1e-4;
-  const logc = (v) => heat((Math.log10(Math.max(v, lo)) - Math.log10(lo)) / 4);
-  put($("v-slice-orig"), m, m, (k) => logc((S0[4 * k] + S0[4 * k + 1] + S0[4 * k + 2]) / 3));
-  put($("v-slice-approx"), m, m, (k) => logc((S1[4 * k] + S1[4 * k + 1] + S1[4 * k + 2]) / 3));
-  bar($("v-bar-slice"), "f (1/sr, mean RGB, log)", lo, peak, (t) => heat(t), true);
+  const lo = state.log ? peak * 1e-4 : 0;
+  const scale = state.log ? (v) => heat((Math.log10(Math.max(v, lo)) - Math.log10(lo)) / 4) : (v) => heat(v / peak);
+  put($("v-slice-orig"), m, m, (k) => scale(value(S0, k)));
+  put($("v-slice-approx"), m, m, (k) => scale(value(S1, k)));
+  const chName = state.channel === "mean" ? "mean RGB" : "RGB"[Number(state.channel)];
+  bar($("v-bar-slice"), "f (1/sr, " + chName + ", " + (state.log ? "log" : "linear") + ")", lo, peak, (t) => heat(t), state.log);
   // In-plane lobes, polar plot.
   const N = 181, P0 = run(id, 2, 0, N, 1, u), P1 = run(id, 2, 1, N, 1, u);
   const cv = $("v-lobe"), ctx = cv.getContext("2d"), W = cv.width, H = cv.height;
@@ -272,6 +277,13 @@ sel.onchange = () => show(sel.value);
 $("v-env").onchange = (e) => { state.env = e.target.checked; draw(); };
 $("v-exposure").oninput = (e) => { state.exposure = Math.pow(2, +e.target.value); draw(); };
 $("v-theta").oninput = (e) => { state.theta_i = +e.target.value * Math.PI / 180; draw(); };
+$("v-phid").oninput = (e) => {
+  state.phi_d = +e.target.value * Math.PI / 180;
+  $("v-phid-val").textContent = e.target.value;
+  draw();
+};
+$("v-channel").onchange = (e) => { state.channel = e.target.value; draw(); };
+$("v-log").onchange = (e) => { state.log = e.target.checked; draw(); };
 $("v-reset").onclick = () => { state.light = runs[state.id].scene.light.slice(); state.yaw = state.pitch = 0; state.cam = camMatrix(); draw(); };
 for (const pid of ["v-orig", "v-approx", "v-diff"]) {
   const cv = $(pid);
@@ -343,5 +355,21 @@ if (testMode) {
   window.dispatchEvent(new PointerEvent("pointerup"));
   $("viewer-test").textContent += "\n" + JSON.stringify({drag: {run: state.id, x, y, light: state.light,
       env_rot: uniforms().env_rot, info: $("v-info").textContent, status: status.textContent}});
+  // The phi_d slider moved to 30 deg through its handler: the approximation's
+  // theta_h - theta_d slice (16 x 16) at the page's state then, and the
+  // slice canvas's mean colour before and after (it must change).
+  const phid = $("v-phid"), canvasMean = () => {
+    const c = $("v-slice-approx"), d = c.getContext("2d").getImageData(0, 0, c.width, c.height).data;
+    let sum = 0;
+    for (let k = 0; k < d.length; k += 4) sum += d[k] + d[k + 1] + d[k + 2];
+    return sum / (d.length / 4 * 3);
+  };
+  const before = canvasMean();
+  phid.value = "30";
+  phid.dispatchEvent(new Event("input"));
+  const sl = run(state.id, 1, 1, 16, 16, uniforms()), slice = [];
+  for (let k = 0; k < 256; ++k) slice.push(sl[4 * k], sl[4 * k + 1], sl[4 * k + 2]);
+  $("viewer-test").textContent += "\n" + JSON.stringify({phid: {run: state.id, phi_d: state.phi_d, slice,
+      canvas_before: before, canvas_after: canvasMean(), label: $("v-phid-val").textContent, status: status.textContent}});
 }
 })();
