@@ -5,6 +5,9 @@
 #   scripts/install-deps.sh           what the default build, tests and reports need
 #   scripts/install-deps.sh --fuzz    also clang and its libFuzzer/sanitizer
 #                                     runtimes, for fuzz/run.sh (build-fuzz/)
+# Then ESLint (the viewer's JavaScript linter, scripts/lint-js.sh) from npm into
+# scripts/eslint/node_modules, pinned by scripts/eslint/package-lock.json; skipped
+# when that lock is already installed, so it works offline once installed.
 # The sanitizer test build (scripts/test-sanitize.sh) uses gcc's ASan/UBSan
 # runtimes (libasan8, libubsan1), which build-essential already brings.
 set -euo pipefail
@@ -35,6 +38,10 @@ PACKAGES=(
   util-linux             # unshare: a test mounts a folder read-only (CI runs as root)
   chromium               # headless test of report.html's WebGL2 viewer
 )
+# node and npm run ESLint (below). A node from another apt source may bring its
+# own npm (Debian's npm package conflicts with it): only when no npm is found
+# are Debian's nodejs and npm asked for.
+if ! command -v npm > /dev/null 2>&1; then PACKAGES+=(nodejs npm); fi
 case "${1:-}" in
   "") ;;
   --fuzz) PACKAGES+=(
@@ -53,12 +60,23 @@ done
 
 if [ ${#missing[@]} -eq 0 ]; then
   echo "install-deps: all ${#PACKAGES[@]} packages present"
-  exit 0
+else
+  SUDO=""
+  if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
+  echo "install-deps: installing ${missing[*]}"
+  export DEBIAN_FRONTEND=noninteractive
+  $SUDO apt-get update -qq
+  $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
 fi
 
-SUDO=""
-if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
-echo "install-deps: installing ${missing[*]}"
-export DEBIAN_FRONTEND=noninteractive
-$SUDO apt-get update -qq
-$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+# ESLint: `npm ci` installs exactly the lock; the stamp (a copy of the lock
+# installed) makes a second run a no-op that needs no network.
+eslint_dir="$(cd "$(dirname "$0")" && pwd)/eslint"
+stamp="$eslint_dir/node_modules/.bf-installed-lock.json"
+if [ -x "$eslint_dir/node_modules/.bin/eslint" ] && cmp -s "$eslint_dir/package-lock.json" "$stamp"; then
+  echo "install-deps: ESLint present ($eslint_dir/node_modules)"
+else
+  echo "install-deps: npm ci in $eslint_dir"
+  (cd "$eslint_dir" && npm ci --no-audit --no-fund --loglevel=error)
+  cp "$eslint_dir/package-lock.json" "$stamp"
+fi

@@ -29,12 +29,15 @@ h1{font-size:1.6em}h2{font-size:1.25em;margin-top:2em;border-bottom:1px solid #d
 table{border-collapse:collapse;font-size:0.82em}td,th{border:1px solid #ccc;padding:2px 6px;text-align:right}
 th{background:#f0f0f0;position:sticky;top:0}td.t{text-align:left}tr.failed td{background:#fde8e8}
 tr.flagged td{background:#fff3e0}td.best,span.best{font-weight:bold;background:#dff3df}.tablewrap{overflow-x:auto;max-width:100%}p.note{font-size:0.85em;color:#555}
-.plots img{max-width:45%;margin:0.5em;border:1px solid #ddd}
+.plots{display:grid;grid-template-columns:repeat(auto-fill,minmax(min(100%,440px),1fr));gap:0.8em}
+.plots figure{margin:0}.plots img{width:100%;border:1px solid #ddd}.plots figcaption{font-size:0.8em;color:#555}
+details.notes summary{cursor:pointer;color:#555}details.notes{max-width:40em;white-space:normal}
+@media (max-width:700px){body{margin:0.6em}#viewer canvas{max-width:100%;height:auto!important}}
 .run{border:1px solid #ddd;border-radius:6px;padding:0.6em 1em;margin:1em 0}
 .run img.sphere{max-width:100%;image-rendering:pixelated}.run img.tex{height:96px;margin-right:4px;image-rendering:pixelated}
 .files a{margin-right:0.8em;font-size:0.85em}
 .vrow{display:flex;flex-wrap:wrap;gap:1em;align-items:flex-start}.vrow figure{margin:0}
-#viewer canvas#v-orig,#viewer canvas#v-approx,#viewer canvas#v-diff{width:256px;height:256px;cursor:crosshair}
+#viewer canvas#v-orig,#viewer canvas#v-approx,#viewer canvas#v-diff{width:256px;height:256px;max-width:28vw;max-height:28vw;cursor:crosshair}
 #viewer canvas#v-slice-orig,#viewer canvas#v-slice-approx{width:180px;height:180px;image-rendering:pixelated}code{background:#f6f6f6;padding:0 3px}
 pre{background:#f6f6f6;padding:0.8em;overflow:auto;font-size:0.85em}
 )";
@@ -104,6 +107,18 @@ std::vector<std::string> html_links(const std::string& html) {
 
 namespace {
 
+// A notes cell folded: its first sentence (up to 60 characters) as the
+// summary, the whole text inside, so a long note does not make its row tall.
+std::string notes_details(const std::string& notes) {
+  std::string head = notes.substr(0, std::min(notes.find(". "), notes.size()));
+  if (head.size() > 60) {
+    size_t cut = 57;  // not inside a UTF-8 sequence
+    while (cut > 0 && (static_cast<unsigned char>(head[cut]) & 0xC0) == 0x80) --cut;
+    head = head.substr(0, cut) + "...";
+  }
+  return "<details class=\"notes\"><summary>" + esc(head) + "</summary>" + esc(notes) + "</details>";
+}
+
 // The results table: key columns first, best values per BRDF marked,
 // failed and flagged rows shaded.
 void results_table(const ExperimentOutput& e, std::ostringstream& h) {
@@ -132,6 +147,7 @@ void results_table(const ExperimentOutput& e, std::ostringstream& h) {
       h << "<td" << (text ? " class=\"t\"" : best ? " class=\"best\" title=\"best " + esc(c) + " of this BRDF\"" : "")
         << ">";
       if (c == "run_id") h << "<a href=\"#run-" << esc(cell) << "\">" << esc(cell) << "</a>";
+      else if (c == "notes" && !cell.empty()) h << notes_details(cell);
       else h << esc(text ? cell : format_short(cell));
       h << "</td>";
     }
@@ -175,7 +191,9 @@ void write_report_html(const ExperimentOutput& e, const OutputFiles& f, const st
     for (const auto& p : f.plots)
       if (exists_in(dir, p)) {
         const bool img = p.size() > 4 && (p.substr(p.size() - 4) == ".png" || p.substr(p.size() - 4) == ".svg");
-        if (img) h << "<a href=\"" << url(p) << "\"><img src=\"" << url(p) << "\" alt=\"" << esc(p) << "\"></a>";
+        if (img)
+          h << "<figure><a href=\"" << url(p) << "\"><img src=\"" << url(p) << "\" alt=\"" << esc(p)
+            << "\"></a><figcaption>" << esc(fs::path(p).filename().string()) << "</figcaption></figure>";
         else h << "<a href=\"" << url(p) << "\">" << esc(p) << "</a> ";
       }
     h << "</div>\n";
@@ -212,8 +230,8 @@ void write_report_html(const ExperimentOutput& e, const OutputFiles& f, const st
     h << "<p>rel_mse " << esc(format_short(cell("rel_mse"))) << ", lin_rmse " << esc(format_short(cell("lin_rmse")))
       << ", cos_rmse " << esc(format_short(cell("cos_rmse"))) << ", " << esc(cell("storage_floats"))
       << " floats, " << esc(format_short(cell("seconds"))) << " s";
-    if (!cell("notes").empty()) h << "<br>" << esc(cell("notes"));
     h << "</p>\n";
+    if (!cell("notes").empty()) h << notes_details(cell("notes")) << "\n";
     std::vector<std::string> pictures, textures, others;
     for (const auto& file : r.files) {
       if (!exists_in(dir, file)) continue;

@@ -169,8 +169,13 @@ std::string viewer_section(const std::vector<ViewerRun>& runs) {
     << "<figure><canvas id=\"v-approx\"></canvas><figcaption>approximation</figcaption></figure>"
     << "<figure><canvas id=\"v-diff\"></canvas><figcaption>|difference|</figcaption></figure></div>\n"
     << "<div class=\"vrow\"><canvas id=\"v-bar-rad\"></canvas> <canvas id=\"v-bar-diff\"></canvas></div>\n"
-    << "<h3>Slices</h3><div class=\"vrow\"><figure><canvas id=\"v-slice-orig\"></canvas><figcaption>original: "
-       "&theta;<sub>h</sub> &rarr; (0..90&deg;), &theta;<sub>d</sub> &uarr; (0..90&deg;), &phi;<sub>d</sub> = 90&deg;"
+    << "<h3>Slices</h3><p><label>&phi;<sub>d</sub> <input id=\"v-phid\" type=\"range\" min=\"0\" max=\"180\" "
+       "value=\"90\"> <span id=\"v-phid-val\">90</span>&deg;</label> <label>channel <select id=\"v-channel\">"
+       "<option value=\"mean\">mean RGB</option><option value=\"0\">R</option><option value=\"1\">G</option>"
+       "<option value=\"2\">B</option></select></label> <label><input id=\"v-log\" type=\"checkbox\" checked> "
+       "log scale</label></p>\n"
+    << "<div class=\"vrow\"><figure><canvas id=\"v-slice-orig\"></canvas><figcaption>original: "
+       "&theta;<sub>h</sub> &rarr; (0..90&deg;), &theta;<sub>d</sub> &uarr; (0..90&deg;), &phi;<sub>d</sub> as set"
        "</figcaption></figure><figure><canvas id=\"v-slice-approx\"></canvas><figcaption>approximation"
        "</figcaption></figure><figure><canvas id=\"v-lobe\" width=\"420\" height=\"240\"></canvas><figcaption>"
        "in-plane lobes: original solid blue, approximation dashed red</figcaption></figure></div>\n"
@@ -185,11 +190,15 @@ std::string viewer_section(const std::vector<ViewerRun>& runs) {
   // Inside a <script> element: no "</script", "<!--" or "<script" (escape.h).
   const std::string text = script_json(list);
   // Test mode writes every viewer.js in while the page is parsed (so the
-  // numbers exist when the page has loaded); otherwise each is loaded when its
-  // run is shown. (The attribute is spelled in pieces: this is page text.)
+  // numbers exist when the page has loaded), "?viewer[=ID]" the run it opens
+  // (and the first, its fallback: drawn before a headless screenshot is
+  // taken); otherwise each is loaded when its run is shown. (The attribute is
+  // spelled in pieces: this is page text.)
   h << "<script>window.BF_VIEWER_FILES = " << text << ";\n"
-    << "if (location.hash === \"#viewer-test\") for (const f of window.BF_VIEWER_FILES) "
-       "document.write(\"<scr\" + \"ipt s\" + \"rc='\" + f.path + \"'></scr\" + \"ipt>\");</script>\n";
+    << "{const q = new URLSearchParams(location.search);\n"
+       "for (const [i, f] of window.BF_VIEWER_FILES.entries()) if (location.hash === \"#viewer-test\" || "
+       "(q.has(\"viewer\") && (i === 0 || f.id === q.get(\"viewer\")))) "
+       "document.write(\"<scr\" + \"ipt s\" + \"rc='\" + f.path + \"'></scr\" + \"ipt>\");}</script>\n";
   h << "<script>" << kViewerScript << "</script>\n</div>\n";
   return h.str();
 }

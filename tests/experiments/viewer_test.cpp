@@ -108,7 +108,7 @@ TEST_CASE("viewer: headless Chromium renders every kind as the CPU does") {
   REQUIRE(close != std::string::npos);
   std::istringstream lines(text.substr(open, close - open));
   std::string line;
-  int runs = 0, drags = 0;
+  int runs = 0, drags = 0, phids = 0;
   std::set<std::string> shown;  // kinds the page drew
   std::map<std::string, std::string> kind_of;  // run id -> the results' method column
   for (const Row& row : read_results_csv(dir / "out/results.csv")) kind_of[row.at("run_id")] = row.at("method");
@@ -130,6 +130,46 @@ TEST_CASE("viewer: headless Chromium renders every kind as the CPU does") {
       CHECK((light - dist * Vec3(0.3, 0.4, std::sqrt(0.75))).norm() < 1e-3 * dist);
       CHECK(d.at("info").get<std::string>().find("point light") != std::string::npos);
       ++drags;
+      continue;
+    }
+    if (j.contains("phid")) {
+      // The phi_d slider moved to 30 deg through its handler: the label and
+      // the slice canvas change, and the page's slice is eval of the export
+      // at phi_d = 30 deg (the same 16 x 16 nodes as the phi_d = 90 check).
+      const auto& p = j.at("phid");
+      CHECK(p.at("status").get<std::string>().empty());
+      CHECK(p.at("label").get<std::string>() == "30");
+      CHECK(p.at("phi_d").get<double>() == Approx(M_PI / 6).epsilon(1e-9));
+      CHECK(p.at("canvas_after").get<double>() != p.at("canvas_before").get<double>());
+      const std::string run_dir = dir / ("out/runs/" + p.at("run").get<std::string>());
+      const BrdfPtr approx = Catalogue::global().make(run_dir + (std::filesystem::exists(run_dir + "/model.json")
+                                                                     ? "/model.json"
+                                                                     : "/factors.json"));
+      const auto gv = p.at("slice").get<std::vector<double>>();
+      std::vector<double> ref, ref90;
+      for (int y = 0; y < 16; ++y)
+        for (int x = 0; x < 16; ++x)
+          for (const double pd : {M_PI / 6, M_PI / 2}) {
+            const double th = M_PI / 2 * (x + 0.5) / 16, td = M_PI / 2 * (15 - y + 0.5) / 16;
+            const Vec3 h(std::sin(th), 0, std::cos(th));
+            const Vec3 d(std::sin(td) * std::cos(pd), std::sin(td) * std::sin(pd), std::cos(td));
+            const Vec3 wi(std::cos(th) * d.x() + std::sin(th) * d.z(), d.y(),
+                          -std::sin(th) * d.x() + std::cos(th) * d.z());
+            const Vec3 wo = 2 * wi.dot(h) * h - wi;
+            const Rgb f = approx->eval(wi.normalized(), wo.normalized());
+            for (int c = 0; c < 3; ++c) (pd < 1 ? ref : ref90).push_back(f[c]);
+          }
+      REQUIRE(gv.size() == ref.size());
+      double w = 0, moved = 0;
+      for (size_t i = 0; i < ref.size(); ++i) {
+        w = std::max(w, std::abs(gv[i] - ref[i]));
+        moved = std::max(moved, std::abs(ref[i] - ref90[i]));
+      }
+      INFO("phi_d slice: worst |gpu - eval| = " << w << " of peak " << max_abs(ref) << "; phi_d 90 -> 30 moves eval by "
+                                               << moved);
+      CHECK(moved > 0.01 * max_abs(ref));  // the slider's change is visible in eval
+      CHECK(w <= 3e-3 * max_abs(ref));
+      ++phids;
       continue;
     }
     const std::string id = j.at("run");
@@ -220,6 +260,7 @@ TEST_CASE("viewer: headless Chromium renders every kind as the CPU does") {
       CHECK(shown.count(kind->name()) == 1);
     }
   CHECK(drags == 1);
+  CHECK(phids == 1);
 }
 
 TEST_CASE("viewer: under the scene's SH lighting the page shades as render_sphere") {
@@ -287,6 +328,7 @@ texture_size = 10
       ++drags;
       continue;
     }
+    if (j.contains("phid")) continue;  // checked in the test above
     INFO("run " << j.at("run").get<std::string>());
     REQUIRE(!j.contains("error"));
     REQUIRE(j.contains("approx_env"));

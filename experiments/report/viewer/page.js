@@ -1,156 +1,3 @@
-// The inline script and shader of report.html's viewer (see viewer.h).
-#pragma once
-
-namespace bf {
-
-// Fragment-shader body appended after "#version 300 es", the run's exported
-// GLSL and "const int BF_ORIG_RES = R;".
-inline constexpr const char* kViewerShaderMain = R"GLSL(
-uniform sampler2D bf_orig;
-uniform vec3 u_light;
-uniform float u_intensity;
-uniform int u_mode;      // 0 sphere, 1 theta_h-theta_d slice, 2 in-plane lobe
-uniform int u_which;     // 0 original (tabulation), 1 approximation (exported GLSL)
-uniform vec2 u_size;
-uniform mat3 u_cam;      // world = u_cam * camera
-uniform float u_theta_i;
-uniform float u_phi_d;
-uniform int u_env;          // 1: light by the scene's SH lighting (lat-long bf_env, rule bf_rule)
-uniform sampler2D bf_env;
-uniform sampler2D bf_rule;  // node k at (k, 0): (direction in the local frame, weight)
-uniform int u_rule_n;
-// The lighting is read at u_env_rot * (world direction): u_env_rot = R^T for
-// an environment turned by R (dragging the light turns it, see the script).
-uniform mat3 u_env_rot;
-out vec4 o_color;
-
-// Bilinear lookup of the lat-long map (theta = pi (y + 1/2) / H, phi = 2 pi (x + 1/2) / W),
-// wrapping in phi, clamped in theta.
-vec3 bf_env_radiance(vec3 w) {
-  ivec2 sz = textureSize(bf_env, 0);
-  float th = acos(clamp(w.z, -1.0, 1.0));
-  float ph = atan(w.y, w.x);
-  if (ph < 0.0) ph += 6.28318531;
-  float x = ph / 6.28318531 * float(sz.x) - 0.5, y = clamp(th / 3.14159265 * float(sz.y) - 0.5, 0.0, float(sz.y - 1));
-  float fx = floor(x);
-  int x0 = int(fx), y0 = min(int(y), sz.y - 2);
-  float a = x - fx, b = y - float(y0);
-  int xa = (x0 + sz.x) % sz.x, xb = (xa + 1) % sz.x;  // x0 >= -1
-  vec3 t00 = texelFetch(bf_env, ivec2(xa, y0), 0).rgb, t10 = texelFetch(bf_env, ivec2(xb, y0), 0).rgb;
-  vec3 t01 = texelFetch(bf_env, ivec2(xa, y0 + 1), 0).rgb, t11 = texelFetch(bf_env, ivec2(xb, y0 + 1), 0).rgb;
-  return mix(mix(t00, t10, a), mix(t01, t11, a), b);
-}
-
-vec2 bf_orig_parabolic(vec3 w) { return w.xy / (1.0 + w.z); }
-vec3 bf_orig_eval(vec3 wi, vec3 wo) {
-  if (wi.z <= 0.0 || wo.z <= 0.0) return vec3(0.0);
-  const int R = BF_ORIG_RES;
-  float Rm = float(R - 1);
-  vec2 si = clamp((bf_orig_parabolic(wi) + 1.0) * 0.5 * Rm, vec2(0.0), vec2(Rm));
-  vec2 so = clamp((bf_orig_parabolic(wo) + 1.0) * 0.5 * Rm, vec2(0.0), vec2(Rm));
-  ivec2 ii = min(ivec2(si), ivec2(R - 2)), io = min(ivec2(so), ivec2(R - 2));
-  vec2 ai = si - vec2(ii), ao = so - vec2(io);
-  vec3 acc = vec3(0.0);
-  for (int a = 0; a < 4; ++a) {
-    ivec2 di = ivec2(a % 2, a / 2);
-    float wa = (di.x == 1 ? ai.x : 1.0 - ai.x) * (di.y == 1 ? ai.y : 1.0 - ai.y);
-    ivec2 ti = ii + di;
-    for (int b = 0; b < 4; ++b) {
-      ivec2 dd = ivec2(b % 2, b / 2);
-      float wb = (dd.x == 1 ? ao.x : 1.0 - ao.x) * (dd.y == 1 ? ao.y : 1.0 - ao.y);
-      ivec2 to = io + dd;
-      acc += wa * wb * texelFetch(bf_orig, ivec2(to.y * R + to.x, ti.y * R + ti.x), 0).rgb;
-    }
-  }
-  return acc;
-}
-// Isotropic originals: MERL-style (theta_h, theta_d, phi_d) table, nodes at
-// theta_h = (i/(NH-1))^2 pi/2, theta_d = j/(ND-1) pi/2, phi_d = k/(NP-1) pi,
-// pixel (k + NP j, i); read trilinearly, phi_d folded into [0, pi].
-vec3 bf_orig_iso(vec3 wi, vec3 wo) {
-  if (wi.z <= 0.0 || wo.z <= 0.0) return vec3(0.0);
-  const float HP = 1.57079633;
-  vec3 h = normalize(wi + wo);
-  float th = acos(clamp(h.z, -1.0, 1.0));
-  float ph = (h.x == 0.0 && h.y == 0.0) ? 0.0 : atan(h.y, h.x);
-  vec3 d = vec3(cos(ph) * wi.x + sin(ph) * wi.y, -sin(ph) * wi.x + cos(ph) * wi.y, wi.z);
-  d = vec3(cos(th) * d.x - sin(th) * d.z, d.y, sin(th) * d.x + cos(th) * d.z);
-  float td = acos(clamp(d.z, -1.0, 1.0));
-  float pd = (d.x == 0.0 && d.y == 0.0) ? 0.0 : atan(d.y, d.x);
-  if (pd < 0.0) pd += 2.0 * HP;
-  vec3 c = vec3(sqrt(clamp(th / HP, 0.0, 1.0)) * float(BF_ORIG_NH - 1), clamp(td / HP, 0.0, 1.0) * float(BF_ORIG_ND - 1),
-                clamp(pd / (2.0 * HP), 0.0, 1.0) * float(BF_ORIG_NP - 1));
-  ivec3 i0 = min(ivec3(c), ivec3(BF_ORIG_NH - 2, BF_ORIG_ND - 2, BF_ORIG_NP - 2));
-  vec3 a = c - vec3(i0);
-  vec3 acc = vec3(0.0);
-  for (int q = 0; q < 8; ++q) {
-    ivec3 o = ivec3(q % 2, (q / 2) % 2, q / 4);
-    float w = (o.x == 1 ? a.x : 1.0 - a.x) * (o.y == 1 ? a.y : 1.0 - a.y) * (o.z == 1 ? a.z : 1.0 - a.z);
-    ivec3 t = i0 + o;
-    acc += w * texelFetch(bf_orig, ivec2(t.z + BF_ORIG_NP * t.y, t.x), 0).rgb;
-  }
-  return acc;
-}
-vec3 bf_eval(vec3 wi, vec3 wo) {
-  if (u_which == 1) return brdf_factor_eval(wi, wo);
-  return BF_ORIG_KIND == 1 ? bf_orig_iso(wi, wo) : bf_orig_eval(wi, wo);
-}
-
-void main() {
-  vec2 f = gl_FragCoord.xy;
-  // Pixel (x, y), y = 0 at the top, as the CPU render (docs/design.md §5.4).
-  float px = -1.0 + 2.0 * f.x / u_size.x;
-  float py = 1.0 - 2.0 * (u_size.y - f.y) / u_size.y;
-  if (u_mode == 0) {
-    float rr = px * px + py * py;
-    if (rr >= 1.0) { o_color = vec4(0.0); return; }
-    vec3 n = u_cam * vec3(px, py, sqrt(1.0 - rr));
-    vec3 wo_w = u_cam * vec3(0.0, 0.0, 1.0);
-    vec3 t = vec3(1.0, 0.0, 0.0) - n.x * n;
-    if (length(t) < 1e-9) t = vec3(0.0, 1.0, 0.0) - n.y * n;
-    t = normalize(t);
-    vec3 b = cross(n, t);
-    vec3 tl = u_light - n;
-    float d2 = dot(tl, tl);
-    vec3 wiw = tl / sqrt(d2);
-    float ci = dot(wiw, n);
-    vec3 wi = vec3(dot(wiw, t), dot(wiw, b), dot(wiw, n));
-    vec3 wo = vec3(dot(wo_w, t), dot(wo_w, b), dot(wo_w, n));
-    vec3 L = vec3(0.0);
-    if (u_env == 1) {
-      if (wo.z > 0.0) {
-        vec3 won = normalize(wo);
-        for (int k = 0; k < u_rule_n; ++k) {
-          vec4 node = texelFetch(bf_rule, ivec2(k, 0), 0);
-          vec3 sw = node.x * t + node.y * b + node.z * n;
-          L += node.w * node.z * bf_env_radiance(u_env_rot * sw) * bf_eval(node.xyz, won);
-        }
-      }
-    } else if (ci > 0.0 && wo.z > 0.0) {
-      L = u_intensity * bf_eval(normalize(wi), normalize(wo)) * ci / d2;
-    }
-    o_color = vec4(L, 1.0);
-  } else if (u_mode == 1) {
-    // BRDF Explorer's image slice: theta_h along x, theta_d along y (up), phi_d fixed,
-    // phi_h = 0; wi = R_y(theta_h) d, wo = 2 (wi.h) h - wi.
-    float th = 0.5 * 3.14159265 * (f.x / u_size.x), td = 0.5 * 3.14159265 * (f.y / u_size.y);
-    vec3 h = vec3(sin(th), 0.0, cos(th));
-    vec3 d = vec3(sin(td) * cos(u_phi_d), sin(td) * sin(u_phi_d), cos(td));
-    vec3 wi = vec3(cos(th) * d.x + sin(th) * d.z, d.y, -sin(th) * d.x + cos(th) * d.z);
-    vec3 wo = 2.0 * dot(wi, h) * h - wi;
-    o_color = vec4(bf_eval(normalize(wi), normalize(wo)), 1.0);
-  } else {
-    // In-plane lobe: wi at theta_i in the x-z plane (phi = 0), wo at theta_o in
-    // [-90, 90] degrees along x (negative: the phi = 180 side).
-    float to = -0.5 * 3.14159265 + 3.14159265 * (f.x / u_size.x);
-    vec3 wi = vec3(sin(u_theta_i), 0.0, cos(u_theta_i));
-    vec3 wo = vec3(sin(to), 0.0, cos(to));
-    o_color = vec4(bf_eval(wi, wo), 1.0);
-  }
-}
-)GLSL";
-
-inline constexpr const char* kViewerScript = R"JS(
 (function () {
 "use strict";
 // viewer.js files are loaded when their run is shown (each is ~1 MB); the
@@ -204,7 +51,7 @@ function setup(id) {
   gl.linkProgram(prog);
   if (!gl.getProgramParameter(prog, gl.LINK_STATUS)) throw new Error(gl.getProgramInfoLog(prog));
   const units = [];
-  r.textures.forEach((t, k) => { units.push({name: t.sampler, tex: texture(t.width, t.height, b64floats(t.data)), values: null}); });
+  r.textures.forEach((t) => { units.push({name: t.sampler, tex: texture(t.width, t.height, b64floats(t.data)), values: null}); });
   const o = r.original;
   units.push({name: "bf_orig", tex: o.kind === "iso" ? texture(o.np * o.nd, o.nh, b64floats(o.data))
                                                     : texture(o.res * o.res, o.res * o.res, b64floats(o.data))});
@@ -288,7 +135,7 @@ function bar(cv, label, lo, hi, ramp, log) {
   ctx.textAlign = "center"; ctx.fillText(label, w / 2, 40);
 }
 const state = {id: null, light: null, cam: [1, 0, 0, 0, 1, 0, 0, 0, 1], yaw: 0, pitch: 0, exposure: 1,
-               theta_i: 30 * Math.PI / 180, phi_d: Math.PI / 2, env: true};
+               theta_i: 30 * Math.PI / 180, phi_d: Math.PI / 2, env: true, channel: "mean", log: true};
 const $ = (q) => document.getElementById(q);
 function camMatrix() {
   const cy = Math.cos(state.yaw), sy = Math.sin(state.yaw), cp = Math.cos(state.pitch), sp = Math.sin(state.pitch);
@@ -341,17 +188,22 @@ function draw() {
   });
   bar($("v-bar-rad"), "radiance (white)", 0, 1 / expo, (t) => [srgb(t), srgb(t), srgb(t)], false);
   bar($("v-bar-diff"), "|difference|", 0, 0.25 / expo, heat, false);
-  // theta_h - theta_d slices, log colour over 4 decades below the original's peak.
+  // theta_h - theta_d slices at the phi_d slider: the chosen channel (or the
+  // mean of R, G, B), log colour over 4 decades below the original's peak or
+  // linear from 0 to it.
   const m = 90;
   const S0 = run(id, 1, 0, m, m, u), S1 = run(id, 1, 1, m, m, u);
+  const value = (S, k) => state.channel === "mean" ? (S[4 * k] + S[4 * k + 1] + S[4 * k + 2]) / 3
+                                                   : S[4 * k + Number(state.channel)];
   let peak = 0;
-  for (let k = 0; k < m * m; ++k) peak = Math.max(peak, (S0[4 * k] + S0[4 * k + 1] + S0[4 * k + 2]) / 3);
+  for (let k = 0; k < m * m; ++k) peak = Math.max(peak, value(S0, k));
   peak = peak > 0 ? peak : 1;
-  const lo = peak * 1e-4;
-  const logc = (v) => heat((Math.log10(Math.max(v, lo)) - Math.log10(lo)) / 4);
-  put($("v-slice-orig"), m, m, (k) => logc((S0[4 * k] + S0[4 * k + 1] + S0[4 * k + 2]) / 3));
-  put($("v-slice-approx"), m, m, (k) => logc((S1[4 * k] + S1[4 * k + 1] + S1[4 * k + 2]) / 3));
-  bar($("v-bar-slice"), "f (1/sr, mean RGB, log)", lo, peak, (t) => heat(t), true);
+  const lo = state.log ? peak * 1e-4 : 0;
+  const scale = state.log ? (v) => heat((Math.log10(Math.max(v, lo)) - Math.log10(lo)) / 4) : (v) => heat(v / peak);
+  put($("v-slice-orig"), m, m, (k) => scale(value(S0, k)));
+  put($("v-slice-approx"), m, m, (k) => scale(value(S1, k)));
+  const chName = state.channel === "mean" ? "mean RGB" : "RGB"[Number(state.channel)];
+  bar($("v-bar-slice"), "f (1/sr, " + chName + ", " + (state.log ? "log" : "linear") + ")", lo, peak, (t) => heat(t), state.log);
   // In-plane lobes, polar plot.
   const N = 181, P0 = run(id, 2, 0, N, 1, u), P1 = run(id, 2, 1, N, 1, u);
   const cv = $("v-lobe"), ctx = cv.getContext("2d"), W = cv.width, H = cv.height;
@@ -425,6 +277,13 @@ sel.onchange = () => show(sel.value);
 $("v-env").onchange = (e) => { state.env = e.target.checked; draw(); };
 $("v-exposure").oninput = (e) => { state.exposure = Math.pow(2, +e.target.value); draw(); };
 $("v-theta").oninput = (e) => { state.theta_i = +e.target.value * Math.PI / 180; draw(); };
+$("v-phid").oninput = (e) => {
+  state.phi_d = +e.target.value * Math.PI / 180;
+  $("v-phid-val").textContent = e.target.value;
+  draw();
+};
+$("v-channel").onchange = (e) => { state.channel = e.target.value; draw(); };
+$("v-log").onchange = (e) => { state.log = e.target.checked; draw(); };
 $("v-reset").onclick = () => { state.light = runs[state.id].scene.light.slice(); state.yaw = state.pitch = 0; state.cam = camMatrix(); draw(); };
 for (const pid of ["v-orig", "v-approx", "v-diff"]) {
   const cv = $(pid);
@@ -473,9 +332,20 @@ if (testMode) {
   $("viewer-test").textContent = out.join("\n");
 }
 // "#viewer=<run_id>" opens that run and scrolls to the viewer.
-const wanted = location.hash.startsWith("#viewer=") ? location.hash.slice(8) : "";
+// "?viewer=<run_id>" ("?viewer": the first run) opens it with the page above
+// the viewer hidden, so the viewer is at the top unscrolled: headless
+// screenshots come out blank once the page has scrolled.
+const query = new URLSearchParams(location.search);
+const wanted = location.hash.startsWith("#viewer=") ? location.hash.slice(8) : query.get("viewer") || "";
 show(ids.includes(wanted) ? wanted : ids[0]);
-if (location.hash.startsWith("#viewer")) $("viewer-h").scrollIntoView();
+if (query.has("viewer")) {
+  for (const el of Array.from(document.body.children)) {
+    if (el.id === "viewer-h") break;
+    el.style.display = "none";
+  }
+} else if (location.hash.startsWith("#viewer")) {
+  $("viewer-h").scrollIntoView();
+}
 if (testMode) {
   // A drag through the real handlers (the first run, shown above): pointer
   // down and up at (x, y) = (0.3, 0.4) of the original sphere's half-width
@@ -485,8 +355,21 @@ if (testMode) {
   window.dispatchEvent(new PointerEvent("pointerup"));
   $("viewer-test").textContent += "\n" + JSON.stringify({drag: {run: state.id, x, y, light: state.light,
       env_rot: uniforms().env_rot, info: $("v-info").textContent, status: status.textContent}});
+  // The phi_d slider moved to 30 deg through its handler: the approximation's
+  // theta_h - theta_d slice (16 x 16) at the page's state then, and the
+  // slice canvas's mean colour before and after (it must change).
+  const phid = $("v-phid"), canvasMean = () => {
+    const c = $("v-slice-approx"), d = c.getContext("2d").getImageData(0, 0, c.width, c.height).data;
+    let sum = 0;
+    for (let k = 0; k < d.length; k += 4) sum += d[k] + d[k + 1] + d[k + 2];
+    return sum / (d.length / 4 * 3);
+  };
+  const before = canvasMean();
+  phid.value = "30";
+  phid.dispatchEvent(new Event("input"));
+  const sl = run(state.id, 1, 1, 16, 16, uniforms()), slice = [];
+  for (let k = 0; k < 256; ++k) slice.push(sl[4 * k], sl[4 * k + 1], sl[4 * k + 2]);
+  $("viewer-test").textContent += "\n" + JSON.stringify({phid: {run: state.id, phi_d: state.phi_d, slice,
+      canvas_before: before, canvas_after: canvasMean(), label: $("v-phid-val").textContent, status: status.textContent}});
 }
 })();
-)JS";
-
-}  // namespace bf
