@@ -51,7 +51,7 @@ TEST_CASE("symmetry: every catalogue BRDF's claimed symmetries hold at symmetric
   for (const auto& [name, m] : cat.models()) specs.push_back(name);
   for (const auto& [name, p] : cat.presets()) specs.push_back(name);
   // Variants without some symmetry, so a wrong claim of the formula is probed too.
-  for (const char* s : {"ward:ax=0.1,ay=0.3", "ashikhmin-shirley:nu=10,nv=200", "lafortune:cx0=-1,cy0=-0.5",
+  for (const char* s : {"ward:ax=0.1,ay=0.3", "ashikhmin-shirley:nu=10,nv=200", "lafortune:cx0=-1,cy0=-0.5,cz0=0.9,n0=8",
                         "separable:a2=0.4", "mccool-form:q4=0.5"})
     specs.push_back(s);
   int without_bilateral = 0;
@@ -158,11 +158,12 @@ TEST_CASE("symmetry: an orbit of samples changes nothing for a BRDF that has the
   CHECK(differ == 0);
   CHECK(w_out == Approx(w_in).epsilon(1e-12));
   // The same orbit of an anisotropic BRDF's samples does change values: the check can fail.
-  const BrdfPtr ward = Catalogue::builtin().make("ward:ax=0.05,ay=0.4");
-  const SampleSet so = expand_orbit(sample_stratified(*ward, 100, 5), {true, false, false}, {8, 2'000'000});
+  const BrdfPtr sep = Catalogue::builtin().make("separable");
+  REQUIRE_FALSE(sep->isotropic());
+  const SampleSet so = expand_orbit(sample_stratified(*sep, 100, 5), {true, false, false}, {8, 2'000'000});
   size_t changed = 0;
-  for (size_t k = 0; k < so.size(); ++k) changed += !close(ward->eval(so.wi[k], so.wo[k]), so.value[k]);
-  CHECK(changed > so.size() / 2);
+  for (size_t k = 0; k < so.size(); ++k) changed += !close(sep->eval(so.wi[k], so.wo[k]), so.value[k]);
+  CHECK(changed > so.size() * 3 / 4);
 }
 
 TEST_CASE("symmetry: the orbit's rotations follow the budget and masked samples are dropped") {
