@@ -144,7 +144,11 @@ MethodVariant with_tolerance_scorer(const MethodVariant& m, const Plan& plan, co
       return shade_rmse(*original, render_sphere(cand, scene));
     };
   } else {
-    if (!domain) throw std::runtime_error("tolerance " + metric + " needs a validation set (validation_pairs > 0)");
+    if (!domain)
+      throw std::runtime_error("tolerance " + metric +
+                               " needs a whole-domain validation set: validation_pairs > 0 and a BRDF that is a "
+                               "truth over the whole domain (an interpolant whose samples declare "
+                               "isotropic+reciprocal+bilateral; docs/design.md §4.1)");
     mv.tolerance->score = [domain, lt, metric](const Brdf& cand) {
       const ValidationScores v = score_validation(cand, domain.get(), nullptr, lt);
       return metric == "val_max_ratio" ? v.max_ratio : metric_value(v.val, metric.substr(4));
