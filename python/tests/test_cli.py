@@ -254,5 +254,5 @@ def test_every_registered_kind_runs_the_same_from_a_config_and_from_python(tmp_p
         # The function bf.<kind> ('-' as '_') is the registry's, with its keys documented.
         fn, needs = bf.METHODS[kind]
         assert getattr(bf, kind.replace("-", "_")) is fn and needs in ("samples", "brdf")
-        for key in options:
+        for key in examples[kind]:
             assert key in fn.__doc__, (kind, key)
