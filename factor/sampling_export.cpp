@@ -109,6 +109,8 @@ std::string sampling_glsl(const SamplerTable& t) {
   s += "#ifndef BRDF_FACTOR_SAMPLING_BINDING\n#define BRDF_FACTOR_SAMPLING_BINDING 15\n#endif\n";
   s += "// Importance sampling of f cos(theta_i) (docs/design.md, \"Importance sampling\"):\n"
        "// brdf_factor_sample(wo, u) = (wi, pdf per solid angle), brdf_factor_pdf(wi, wo) = that pdf.\n"
+       "// NOT YET TRUSTED: on llvmpipe these do not agree with the CPU sampler for every (wo, u)\n"
+       "// (docs/design.md, \"sampling.glsl\"); use the CPU or Python sampler until they do.\n"
        "BRDF_FACTOR_BINDING(BRDF_FACTOR_SAMPLING_BINDING) uniform sampler2D brdf_factor_sampling;\n";
   s += "const int BF_S_T = " + T + ";\nconst int BF_S_P = " + P + ";\nconst int BF_S_V = " + V +
        ";\nconst int BF_S_VP = " + VP + ";\nconst int BF_S_W = " + W1 +
