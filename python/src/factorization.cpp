@@ -3,16 +3,11 @@
 #include "brdfs/merl.h"
 #include "common.h"
 #include "factor/export.h"
-#include "factor/homomorphic.h"
 #include "factor/model_fit.h"
 
 namespace bf::py_module {
 
 namespace {
-
-std::shared_ptr<const HomomorphicFactorization> homomorphic(const PyFactorization& f) {
-  return std::dynamic_pointer_cast<const HomomorphicFactorization>(f.f);
-}
 
 py::dict exported_dict(const ExportedFiles& e) {
   py::dict d;
@@ -109,29 +104,36 @@ and exports.)doc")
       .def(
           "textures",
           [](const PyFactorization& f) {
-            auto h = homomorphic(f);
-            if (!h)
+            // What the exported GLSL samples (Factorization::viewer_data): the
+            // result says, no branch on its type here.
+            std::optional<ShaderView> v;
+            {
+              py::gil_scoped_release release;
+              v = f.f->viewer_data();
+            }
+            if (!v || v->textures.empty())
               throw std::invalid_argument("textures: method " + f.f->method() +
-                                          " has no log textures (only mccool, fit and search factorizations)");
+                                          " stores no textures (its export samples none)");
             py::list out;
-            for (const auto& t : h->terms()) {
-              const int r = t.proj.res;
-              py::array_t<float> a({r, r, 3});
-              auto v = a.mutable_unchecked<3>();
-              for (int j = 0; j < r; ++j)
-                for (int i = 0; i < r; ++i)
-                  for (int c = 0; c < 3; ++c) v(j, i, c) = t.texels[c][j * r + i];
+            for (const auto& [name, img] : v->textures) {
+              const int w = img.width, h = img.height, nc = img.channels();
+              py::array_t<float> a({h, w, nc});
+              std::copy(img.pixels.begin(), img.pixels.end(), a.mutable_data());
               out.append(a);
             }
             return out;
           },
-          "Homomorphic factorizations: each term's log-space texels as a (res, res, 3) float32 array, "
-          "[j, i] = texel (i, j) (what the EXR holds; 0 outside the mask).")
+          "The textures the exported GLSL samples, in binding order, each a (height, width, channels) float32 "
+          "array, [j, i] = texel (i, j), what the export's EXR holds. mccool, fit, search: each term's log-space "
+          "texels (res, res, 3), 0 outside the mask; svd, sh-k: their factor tables. Raises ValueError for a "
+          "result that stores none (sh-r, model-fit).")
       .def_property_readonly("A", [](const PyFactorization& f) -> py::object {
-        auto h = homomorphic(f);
-        if (!h) return py::none();
-        return py::make_tuple(h->A()[0], h->A()[1], h->A()[2]);
-      }, "homomorphic: the per-channel scale A, else None")
+        // The sidecar's per-channel scale (describe()["A"]) where the result has one.
+        const nlohmann::json d = f.f->describe();
+        const auto a = d.find("A");
+        if (a == d.end() || !a->is_array() || a->size() != 3) return py::none();
+        return py::make_tuple((*a)[0].get<double>(), (*a)[1].get<double>(), (*a)[2].get<double>());
+      }, "mccool, fit, search: the per-channel scale A of the sidecar, else None")
       .def(
           "export",
           [](const PyFactorization& f, const std::string& dir, const std::string& stem) -> py::dict {
