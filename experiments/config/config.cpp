@@ -417,8 +417,8 @@ void read_method(Reader& r, const MethodKind& kind, uint64_t base_seed, MethodVa
     r.fail("refine", "refine = \"" + m.refine + "\" applies to the homomorphic kinds (" +
                          join(refinable_kind_names()) + ") only; kind = \"" + m.kind + "\" needs refine = \"none\"");
   o["refine"] = m.refine;
-  m.sampling = r.boolean(find_key(common_method_keys(), "sampling"), false);
-  if (m.sampling) o["sampling"] = true;  // (absent when false: run ids of configs without it unchanged)
+  m.sampler = r.boolean(find_key(common_method_keys(), "sampler"), false);
+  if (m.sampler) o["sampler"] = true;  // (absent when false: run ids of configs without it unchanged)
   // Scene-weighted fits (experiments/report/scene_weights.h): in the options,
   // hence the run id, only when asked for.
   const std::string weight_fit = r.choice(find_key(common_method_keys(), "weight_fit"), "none");

@@ -8,6 +8,7 @@
 #include "experiments/common/cli_util.h"
 #include "experiments/config/config.h"
 #include "experiments/plan/config_reader.h"
+#include "factor/lighting.h"
 
 namespace bf {
 

@@ -90,7 +90,7 @@ const std::vector<KeySpec>& common_method_keys() {
       choice_key("refine", {"none", "linear", "cosine", "blend"}, "none",
                  "the nonlinear refinement stage (`factor/refine.h`) after the fit or search; homomorphic kinds "
                  "only, an error elsewhere. See [Refinement](#refinement)"),
-      bool_key("sampling", "false",
+      bool_key("sampler", "false",
                "also build the importance sampler of the result (`factor/sampling.h`, default options): columns "
                "`sampler_storage` and `sampler_build_s`; with `export`, `sampling.exr`, `sampling.glsl` and "
                "`sampling.json` in the run folder (docs/design.md, Importance sampling)"),

@@ -44,8 +44,8 @@ void read_projections(Reader& r, MethodVariant& m, json& o) {
     const Combo c = plain_combo(*t);
     Reader pr(ctx, c, field, ctx.where(e));
     const bool has_param = pr.has("parameterization");
-    Parameterization param = read_param(pr, "parameterization", m.param);
-    const bool recip = pr.boolean("reciprocal", m.reciprocity);
+    Parameterization param = read_param(pr, "parameterization", homomorphic_options(m).param);
+    const bool recip = pr.boolean("reciprocal", homomorphic_options(m).reciprocity);
     Mat24 P = Mat24::Zero();
     std::string name;
     if (pr.has("matrix") == pr.has("name")) {
@@ -95,7 +95,7 @@ void read_projections(Reader& r, MethodVariant& m, json& o) {
       r.mark_failed();
       continue;
     }
-    m.projections.push_back({proj, recip, std::nullopt});
+    homomorphic_options(m).projections.push_back({proj, recip, std::nullopt});
     json pj = {{"parameterization", to_string(param)}, {"reciprocal", recip}};
     if (!name.empty()) pj["name"] = name;
     pj["matrix"] = {{P(0, 0), P(0, 1), P(0, 2), P(0, 3)}, {P(1, 0), P(1, 1), P(1, 2), P(1, 3)}};
@@ -150,14 +150,15 @@ class FitKind final : public HomomorphicKind {
   void read(Reader& r, MethodVariant& m, json& o, uint64_t) const override {
     read_refine_options(r, m, o);
     m.texture_size = read_texture_size(r, m, o, 16, kFitTextureMin, kFitTextureMax);
-    m.param = read_param(r, "parameterization", Parameterization::WiWo);
-    m.reciprocity = r.boolean("reciprocity", false);
-    read_fit_options(r, m.fit, o);
+    HomomorphicOptions& h = homomorphic_options(m);
+    h.param = read_param(r, "parameterization", Parameterization::WiWo);
+    h.reciprocity = r.boolean("reciprocity", false);
+    read_fit_options(r, h.fit, o);
     m.tolerance = read_tolerance(r, o);
-    o["parameterization"] = to_string(m.param);
-    o["reciprocity"] = m.reciprocity;
+    o["parameterization"] = to_string(h.param);
+    o["reciprocity"] = h.reciprocity;
     read_projections(r, m, o);
-    const int n = static_cast<int>(m.projections.size());
+    const int n = static_cast<int>(h.projections.size());
     m.terms = static_cast<int>(r.integer(find_key(fit_kind_keys(), "terms"), std::max(n, 1)));
     if (n > 0 && m.terms > n)
       r.fail("terms", "terms = " + std::to_string(m.terms) + " but only " + std::to_string(n) +
@@ -173,19 +174,20 @@ class FitKind final : public HomomorphicKind {
 
   MethodOutcome run(const RunContext& c) const override {
     const MethodVariant& m = c.method;
-    const FitData data(c.samples, m.fit.eps);
+    const HomomorphicOptions& h = homomorphic_options(m);
+    const FitData data(c.samples, h.fit.eps);
     HomomorphicRun run;
     std::optional<SizeChoice> choice;
     if (m.tolerance) {
       const std::vector<int> ladder =
           m.texture_ladder.empty() ? std::vector<int>{m.texture_size} : m.texture_ladder;
-      const auto terms_at = [&](int res) { return terms_at_resolution(m.projections, res); };
-      choice = select_homomorphic_size(data, c.samples, c.lt, terms_at, 1, m.cap, m.fit, "fit", *m.tolerance, ladder);
+      const auto terms_at = [&](int res) { return terms_at_resolution(h.projections, res); };
+      choice = select_homomorphic_size(data, c.samples, c.lt, terms_at, 1, m.cap, h.fit, "fit", *m.tolerance, ladder);
       run.h = std::dynamic_pointer_cast<const HomomorphicFactorization>(choice->result);
       run.errors_after_term = choice->errors_after_term;
     } else {
-      run.h = fit_homomorphic(data, std::vector<TermSpec>(m.projections.begin(), m.projections.begin() + m.terms),
-                              m.fit, "fit", &run.errors_after_term);
+      run.h = fit_homomorphic(data, std::vector<TermSpec>(h.projections.begin(), h.projections.begin() + m.terms),
+                              h.fit, "fit", &run.errors_after_term);
     }
     return finish_homomorphic(c, std::move(run), std::move(choice), 0);
   }

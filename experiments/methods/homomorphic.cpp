@@ -85,7 +85,7 @@ void read_fit_options(Reader& r, FitOptions& f, json& o) {
 }
 
 void read_refine_options(Reader& r, MethodVariant& m, json& o) {
-  RefineOptions& ro = m.refine_options;
+  RefineOptions& ro = homomorphic_options(m).refine;
   ro.objective = m.refine == "none" ? ro.objective : m.refine;
   ro.blend_weight = r.number(refine_key("refine_blend"), ro.blend_weight);
   ro.max_iterations = static_cast<int>(r.integer(refine_key("refine_iterations"), ro.max_iterations));
@@ -103,15 +103,16 @@ void read_refine_options(Reader& r, MethodVariant& m, json& o) {
 void validate_fit_options(Reader& r, const MethodVariant& m) {
   if (r.failed()) return;
   try {
-    m.fit.validate();
+    homomorphic_options(m).fit.validate();
   } catch (const std::exception& e) {
     report_invalid(r, e, method_keys(*m.impl));
   }
 }
 
 void finish_refine_options(Reader& r, MethodVariant& m, json& o) {
-  RefineOptions& ro = m.refine_options;
-  if (ro.smoothing < 0) ro.smoothing = m.fit.smoothing;
+  HomomorphicOptions& ho = homomorphic_options(m);
+  RefineOptions& ro = ho.refine;
+  if (ro.smoothing < 0) ro.smoothing = ho.fit.smoothing;
   if (m.refine != "none") o["refine_smoothing"] = ro.smoothing;
   ro.threads = 1;
   if (r.failed()) return;
@@ -127,6 +128,7 @@ void finish_refine_options(Reader& r, MethodVariant& m, json& o) {
 MethodOutcome finish_homomorphic(const RunContext& c, HomomorphicRun run, std::optional<SizeChoice> choice,
                                  int evaluations) {
   const MethodVariant& m = c.method;
+  const RefineOptions& ro = homomorphic_options(m).refine;
   MethodOutcome out;
   out.choice = std::move(choice);
   out.evaluations = evaluations;
@@ -137,14 +139,14 @@ MethodOutcome finish_homomorphic(const RunContext& c, HomomorphicRun run, std::o
     const auto t0 = std::chrono::steady_clock::now();
     RefineReport rep;
     try {
-      run.h = refine(*run.h, c.samples, m.refine_options, &rep);
+      run.h = refine(*run.h, c.samples, ro, &rep);
       out.record["refinement"] = {{"objective", rep.objective},        {"linear_solver", rep.linear_solver},
                                   {"iterations", rep.iterations},      {"seconds", rep.seconds},
                                   {"initial_cost", rep.initial_cost},  {"final_cost", rep.final_cost},
                                   {"termination", rep.termination},    {"parameters", rep.parameters},
                                   {"residuals", rep.residuals},        {"texels_added", rep.texels_added},
-                                  {"blend_weight", m.refine_options.blend_weight},
-                                  {"smoothing", m.refine_options.smoothing}};
+                                  {"blend_weight", ro.blend_weight},
+                                  {"smoothing", ro.smoothing}};
     } catch (const std::runtime_error& ex) {
       // Ceres found no finite solution: the start is the best answer.
       out.notes.push_back(std::string("refinement failed, unrefined fit kept: ") + ex.what());

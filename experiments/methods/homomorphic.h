@@ -8,8 +8,24 @@
 
 #include "experiments/methods/method_kind.h"
 #include "factor/homomorphic_fit.h"
+#include "factor/refine.h"
+#include "search/term_search.h"
 
 namespace bf {
+
+// The typed options of the homomorphic kinds (MethodVariant::typed).
+struct HomomorphicOptions {
+  Parameterization param = Parameterization::WiWo;
+  bool reciprocity = false;
+  FitOptions fit;                    // mccool, fit, search (search.fit mirrors it)
+  std::vector<TermSpec> projections; // fit: all configured projections at texture_size
+  SearchOptions search;              // search
+  RefineOptions refine;              // the refinement stage (MethodVariant::refine names it)
+};
+inline HomomorphicOptions& homomorphic_options(MethodVariant& m) { return kind_options<HomomorphicOptions>(m); }
+inline const HomomorphicOptions& homomorphic_options(const MethodVariant& m) {
+  return kind_options<HomomorphicOptions>(m);
+}
 
 // The fit keys (texture_size with the given default docs, smoothing, eps,
 // subtract_eps, solve_last, solver) and the refinement keys.

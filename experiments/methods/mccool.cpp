@@ -41,8 +41,9 @@ class McCoolKind final : public HomomorphicKind {
       r.fail("terms", "kind = \"mccool\" has exactly 2 textures (p(wi)/p(wo) shared, and p(h)), found " +
                           show(*tn));
     m.terms = 2;
-    read_fit_options(r, m.fit, o);
-    m.param = Parameterization::WiWo;
+    HomomorphicOptions& h = homomorphic_options(m);
+    read_fit_options(r, h.fit, o);
+    h.param = Parameterization::WiWo;
     o["terms"] = 2;
     validate_fit_options(r, m);
     finish_refine_options(r, m, o);
@@ -50,16 +51,17 @@ class McCoolKind final : public HomomorphicKind {
 
   MethodOutcome run(const RunContext& c) const override {
     const MethodVariant& m = c.method;
-    const FitData data(c.samples, m.fit.eps);
+    const FitOptions& fit = homomorphic_options(m).fit;
+    const FitData data(c.samples, fit.eps);
     HomomorphicRun run;
     std::optional<SizeChoice> choice;
     if (m.tolerance) {
-      choice = select_homomorphic_size(data, c.samples, c.lt, mccool_terms, 2, 2, m.fit, "mccool", *m.tolerance,
+      choice = select_homomorphic_size(data, c.samples, c.lt, mccool_terms, 2, 2, fit, "mccool", *m.tolerance,
                                        m.texture_ladder);
       run.h = std::dynamic_pointer_cast<const HomomorphicFactorization>(choice->result);
       run.errors_after_term = choice->errors_after_term;
     } else {
-      run.h = fit_homomorphic(data, mccool_terms(m.texture_size), m.fit, "mccool", &run.errors_after_term);
+      run.h = fit_homomorphic(data, mccool_terms(m.texture_size), fit, "mccool", &run.errors_after_term);
     }
     return finish_homomorphic(c, std::move(run), std::move(choice), 0);
   }

@@ -73,7 +73,7 @@ class ModelFitKind final : public MethodKind {
   std::vector<std::string> columns() const override { return {"model"}; }
 
   void read(Reader& r, MethodVariant& m, json& o, uint64_t base_seed) const override {
-    ModelFitOptions& f = m.model_fit;
+    ModelFitOptions& f = kind_options<ModelFitOptions>(m);
     f.model = r.text("model", f.model);
     f.metric = r.choice(key("metric"), f.metric);
     f.cube_root = r.boolean(key("cube_root"), f.cube_root);
@@ -102,7 +102,7 @@ class ModelFitKind final : public MethodKind {
 
   MethodOutcome run(const RunContext& c) const override {
     MethodOutcome out;
-    auto mf = std::make_shared<ModelFitFactorization>(fit_model(c.samples, c.method.model_fit));
+    auto mf = std::make_shared<ModelFitFactorization>(fit_model(c.samples, kind_options<ModelFitOptions>(c.method)));
     const ModelFitResult& res = mf->result();
     json params = json::object();
     for (const auto& [k, v] : res.parameters) params[k] = v;

@@ -117,14 +117,15 @@ void read_guesses(Reader& r, SearchOptions& s) {
 
 // The search's effective options, hashed into the run id.
 void record_options(const MethodVariant& m, json& o) {
-  const SearchOptions& s = m.search;
-  o["parameterization"] = to_string(m.param);
+  const HomomorphicOptions& h = homomorphic_options(m);
+  const SearchOptions& s = h.search;
+  o["parameterization"] = to_string(h.param);
   o["terms"] = m.terms;
   o["texture_size"] = m.texture_size;
   o["search_texture_size"] = s.search_texture_size;
   o["restarts"] = s.restarts;
   o["guesses"] = s.guesses;
-  o["reciprocity"] = m.reciprocity;
+  o["reciprocity"] = h.reciprocity;
   o["optimizer"] = s.optimizer;
   o["ftol"] = s.powell.ftol;
   o["line_tol"] = s.powell.line_tol;
@@ -196,13 +197,14 @@ class SearchKind final : public HomomorphicKind {
   }
   void fill_row(const RunContext& c, MethodOutcome& out, Row& row) const override {
     fill_homomorphic_row(c, out, row);
-    row["parameterization"] = asked_parameterization(c.method.search);
+    row["parameterization"] = asked_parameterization(homomorphic_options(c.method).search);
     row["search_strategy"] = out.record.value("search_strategy", "");
   }
 
   void read(Reader& r, MethodVariant& m, json& o, uint64_t base_seed) const override {
     read_refine_options(r, m, o);
-    SearchOptions& s = m.search;
+    HomomorphicOptions& h = homomorphic_options(m);
+    SearchOptions& s = h.search;
     // Configs default to both searches, the better one kept (never worse than
     // Cole's greedy search at any term count); "greedy" reproduces earlier results.
     // A greedy-only key (beam, backfit_*, optimizer) without a strategy means greedy.
@@ -219,10 +221,10 @@ class SearchKind final : public HomomorphicKind {
     s.beam_width = static_cast<int>(r.integer(key("beam_width"), s.beam_width));
     s.final_joint = r.boolean(key("final_joint"), s.final_joint);
     s.joint_polish_terms = static_cast<int>(r.integer(key("joint_polish_terms"), s.joint_polish_terms));
-    m.param = read_param(r, "parameterization", s.param);
+    h.param = read_param(r, "parameterization", s.param);
     if (param_given && r.has("term_param") && s.term_param == "either")
       r.fail("term_param", "term_param = \"either\" lets the search choose each term's parameterization, which "
-                           "contradicts the explicit parameterization = \"" + to_string(m.param) +
+                           "contradicts the explicit parameterization = \"" + to_string(h.param) +
                            "\"; expected term_param = \"fixed\" or no term_param (with parameterization every "
                            "term reads it), or no parameterization (the search chooses per term)");
     m.tolerance = read_tolerance(r, o);
@@ -235,7 +237,7 @@ class SearchKind final : public HomomorphicKind {
     if (s.search_texture_size == 1) r.fail("search_texture_size", "expected 0 (same as texture_size) or 2..1024, found 1");
     s.restarts = static_cast<int>(r.integer(key("restarts"), s.restarts));
     read_guesses(r, s);
-    m.reciprocity = r.boolean(key("reciprocity"), false);
+    h.reciprocity = r.boolean(key("reciprocity"), false);
     s.optimizer = r.choice(key("optimizer"), s.optimizer);
     s.powell.ftol = r.number(key("ftol"), s.powell.ftol);
     s.powell.line_tol = r.number(key("line_tol"), s.powell.line_tol);
@@ -248,14 +250,14 @@ class SearchKind final : public HomomorphicKind {
     s.backfit_sweeps = static_cast<int>(r.integer(key("backfit_sweeps"), s.backfit_sweeps));
     s.backfit_restarts = static_cast<int>(r.integer(key("backfit_restarts"), s.backfit_restarts));
     m.seed = static_cast<uint64_t>(r.integer(key("seed"), static_cast<int64_t>(base_seed)));
-    read_fit_options(r, m.fit, o);
+    read_fit_options(r, h.fit, o);
     if (s.strategy != "structured" && s.restarts == 0 && s.guesses.empty() && !r.failed())
       r.fail("restarts", "restarts = 0 and no guesses leave nothing to search from (give restarts >= 1 or guesses)");
     s.terms = m.terms;
-    s.param = m.param;
+    s.param = h.param;
     s.texture_size = m.texture_size;
-    s.reciprocity = m.reciprocity;
-    s.fit = m.fit;
+    s.reciprocity = h.reciprocity;
+    s.fit = h.fit;
     s.seed = m.seed;
     record_options(m, o);
     if (m.tolerance && s.beam != 1)
@@ -276,8 +278,9 @@ class SearchKind final : public HomomorphicKind {
 
   MethodOutcome run(const RunContext& c) const override {
     const MethodVariant& m = c.method;
-    const FitData data(c.samples, m.fit.eps);
-    SearchOptions so = m.search;
+    const HomomorphicOptions& h = homomorphic_options(m);
+    const FitData data(c.samples, h.fit.eps);
+    SearchOptions so = h.search;
     SizeChoice choice;  // with a tolerance: the terms tried, filled as the search goes
     if (m.tolerance) {
       // The greedy search stops at the first term whose refit reaches the

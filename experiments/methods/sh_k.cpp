@@ -48,7 +48,7 @@ class ShkKind final : public MethodKind {
   std::vector<std::string> columns() const override { return {"texture_size", "order"}; }
 
   void read(Reader& r, MethodVariant& m, json& o, uint64_t) const override {
-    ShkOptions& k = m.shk;
+    ShkOptions& k = kind_options<ShkOptions>(m);
     m.tolerance = read_tolerance(r, o);
     k.order = static_cast<int>(r.integer(key("order"), m.tolerance ? 30 : k.order));
     m.texture_size = static_cast<int>(r.integer(key("texture_size"), k.view_res));
@@ -85,22 +85,24 @@ class ShkKind final : public MethodKind {
     const int L = plan.scene.lighting->order;
     m.options["lighting_cap"] = L;
     if (m.tolerance) m.cap = std::min(m.cap, L);
-    m.shk.order = std::min(m.shk.order, L);
-    m.options["order"] = m.shk.order;
+    ShkOptions& k = kind_options<ShkOptions>(m);
+    k.order = std::min(k.order, L);
+    m.options["order"] = k.order;
   }
 
   bool tabulates() const override { return true; }
   void export_files(const RunContext& c, const MethodOutcome& out) const override { export_tabulated(c, out); }
   // Float64 data + float32 EXR + the viewer's base64 copy: about 18 bytes per value.
   uint64_t export_bytes(const MethodVariant& m) const override {
-    const uint64_t res = uint64_t(std::max(m.shk.view_res, 2));
-    const uint64_t order = uint64_t(std::max({m.shk.order, m.cap, 0}) + 1);
+    const ShkOptions& k = kind_options<ShkOptions>(m);
+    const uint64_t res = uint64_t(std::max(k.view_res, 2));
+    const uint64_t order = uint64_t(std::max({k.order, m.cap, 0}) + 1);
     return order * order * res * res * 3 * 18;
   }
   MethodOutcome run(const RunContext& c) const override {
     const MethodVariant& m = c.method;
     // An isotropic BRDF (by the azimuthal-invariance test) is stored along phi_v = 0 only.
-    ShkOptions ko = m.shk;
+    ShkOptions ko = kind_options<ShkOptions>(m);
     ko.reduced = m.options.value("reduce_isotropic", false) && c.isotropy.isotropic;
     MethodOutcome out;
     if (m.tolerance) {

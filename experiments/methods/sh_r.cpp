@@ -17,6 +17,14 @@ using nlohmann::json;
 
 namespace {
 
+// sh-r's typed options (MethodVariant::typed).
+struct ShrKindOptions {
+  ShrOptions shr;
+  bool shrm = false;  // also the SHRM under the scene's SH lighting
+};
+ShrKindOptions& shr_options(MethodVariant& m) { return kind_options<ShrKindOptions>(m); }
+const ShrKindOptions& shr_options(const MethodVariant& m) { return kind_options<ShrKindOptions>(m); }
+
 const std::vector<KeySpec>& shr_keys() {
   static const std::vector<KeySpec> keys = {
       int_key("order", 0, ShrOptions::kMaxOrder, "",
@@ -67,7 +75,7 @@ class ShrKind final : public MethodKind {
   std::vector<std::string> columns() const override { return {"order", "view_order"}; }
 
   void read(Reader& r, MethodVariant& m, json& o, uint64_t) const override {
-    ShrOptions& s = m.shr;
+    ShrOptions& s = shr_options(m).shr;
     m.tolerance = read_tolerance(r, o);
     const bool has_order = r.has("order"), has_view = r.has("view_order");
     s.max_order = static_cast<int>(r.integer(key("max_order"), s.max_order));
@@ -91,8 +99,9 @@ class ShrKind final : public MethodKind {
     s.theta_o_nodes = static_cast<int>(r.integer(key("theta_o_nodes"), 0));
     s.phi_nodes = static_cast<int>(r.integer(key("phi_nodes"), 0));
     s.min_cos = r.number(key("min_cos"), s.min_cos);
-    m.shrm = r.boolean(key("shrm"), false);
-    if (m.shrm) o["shrm"] = true;  // absent when false: existing run ids unchanged
+    bool& shrm = shr_options(m).shrm;
+    shrm = r.boolean(key("shrm"), false);
+    if (shrm) o["shrm"] = true;  // absent when false: existing run ids unchanged
     record_options(s, o);
     if (m.tolerance) m.cap = s.max_order;
     m.cores = hardware_threads();
@@ -113,18 +122,19 @@ class ShrKind final : public MethodKind {
       if (!b.brdf->isotropic())
         ctx.issue(m.where, "method.kind", "sh-r needs an isotropic BRDF, but brdf '" + b.label +
                                               "' is anisotropic (use sh-k)");
-    if (m.shrm && !plan.scene.lighting)
+    if (shr_options(m).shrm && !plan.scene.lighting)
       ctx.issue(m.where, "method.shrm",
                 "shrm = true needs SH lighting: set [scene] environment = \"<lat-long map>\" or lighting_order");
     if (!plan.scene.lighting) return;
     const int L = plan.scene.lighting->order;
     json& o = m.options;
     o["lighting_cap"] = L;
-    m.shr.max_order = std::min(m.shr.max_order, L);
-    if (m.shr.order > L) m.shr.order = L;
+    ShrOptions& s = shr_options(m).shr;
+    s.max_order = std::min(s.max_order, L);
+    if (s.order > L) s.order = L;
     if (m.tolerance) m.cap = std::min(m.cap, L);
-    o["max_order"] = m.shr.max_order;
-    o["order"] = m.shr.order;
+    o["max_order"] = s.max_order;
+    o["order"] = s.order;
   }
 
   bool tabulates() const override { return true; }
@@ -133,10 +143,10 @@ class ShrKind final : public MethodKind {
     const MethodVariant& m = c.method;
     MethodOutcome out;
     if (m.tolerance) {
-      out.choice = select_shr_orders_by_metric(*c.brdf.brdf, c.samples, m.shr, *m.tolerance);
+      out.choice = select_shr_orders_by_metric(*c.brdf.brdf, c.samples, shr_options(m).shr, *m.tolerance);
       out.result = out.choice->result;
     } else {
-      out.result = fit_shr(*c.brdf.brdf, m.shr);
+      out.result = fit_shr(*c.brdf.brdf, shr_options(m).shr);
     }
     return out;
   }
@@ -151,7 +161,7 @@ class ShrKind final : public MethodKind {
   // The SHRM under the scene's SH lighting: its storage, time and shade_rmse
   // against the original's render (same scene).
   void extra_outputs(const RunContext& c, MethodOutcome& out, Row&) const override {
-    if (!c.method.shrm || !c.plan.scene.lighting) return;
+    if (!shr_options(c.method).shrm || !c.plan.scene.lighting) return;
     const auto shr = std::dynamic_pointer_cast<const ShrFactorization>(out.result);
     const auto t1 = std::chrono::steady_clock::now();
     const Shrm shrm(*shr, *c.plan.scene.lighting);

@@ -68,11 +68,11 @@ class SvdKind final : public MethodKind {
   }
 
   void read(Reader& r, MethodVariant& m, json& o, uint64_t) const override {
-    SvdOptions& v = m.svd;
+    SvdOptions& v = kind_options<SvdOptions>(m);
     m.texture_size = read_texture_size(r, m, o, v.res, kTextureMin, kTextureMax);
     m.tolerance = read_tolerance(r, o);
     m.terms = static_cast<int>(r.integer(key("terms"), m.tolerance ? 16 : v.rank));
-    m.param = read_param(r, "parameterization", v.param);
+    v.param = read_param(r, "parameterization", v.param);
     v.log = r.boolean(key("log"), v.log);
     if (!v.log)
       for (const char* k : {"eps", "subtract_eps"})
@@ -87,7 +87,6 @@ class SvdKind final : public MethodKind {
     v.float_textures = r.boolean(key("float_textures"), v.float_textures);
     v.res = m.texture_size;
     v.rank = m.terms;
-    v.param = m.param;
     record_options(v, o);
     if (m.tolerance) m.cap = m.terms;
     m.cores = hardware_threads();
@@ -113,18 +112,20 @@ class SvdKind final : public MethodKind {
   void export_files(const RunContext& c, const MethodOutcome& out) const override { export_tabulated(c, out); }
   // Float64 data + float32 EXR + the viewer's base64 copy: about 18 bytes per value.
   uint64_t export_bytes(const MethodVariant& m) const override {
-    const uint64_t res = uint64_t(std::max(m.svd.res, 2));
-    return uint64_t(std::max({m.svd.rank, m.terms, m.cap, 1})) * 2 * res * res * 3 * 18;
+    const SvdOptions& v = kind_options<SvdOptions>(m);
+    const uint64_t res = uint64_t(std::max(v.res, 2));
+    return uint64_t(std::max({v.rank, m.terms, m.cap, 1})) * 2 * res * res * 3 * 18;
   }
   MethodOutcome run(const RunContext& c) const override {
     const MethodVariant& m = c.method;
+    const SvdOptions& v = kind_options<SvdOptions>(m);
     MethodOutcome out;
     if (m.tolerance && !m.texture_ladder.empty())
-      out.choice = select_svd_size(*c.brdf.brdf, c.samples, m.svd, *m.tolerance, m.cap, m.texture_ladder);
+      out.choice = select_svd_size(*c.brdf.brdf, c.samples, v, *m.tolerance, m.cap, m.texture_ladder);
     else if (m.tolerance)
-      out.choice = select_svd_rank(*c.brdf.brdf, c.samples, m.svd, *m.tolerance, m.cap);
+      out.choice = select_svd_rank(*c.brdf.brdf, c.samples, v, *m.tolerance, m.cap);
     else
-      out.result = fit_svd(*c.brdf.brdf, m.svd);
+      out.result = fit_svd(*c.brdf.brdf, v);
     if (out.choice) out.result = out.choice->result;
     return out;
   }

@@ -17,6 +17,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "brdfs/directions.h"
 #include "experiments/plan/plan.h"
 
 namespace bf {

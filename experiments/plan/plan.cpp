@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "brdfs/file_check.h"
+#include "factor/lighting.h"
 
 namespace bf {
 

@@ -13,17 +13,12 @@
 #include <vector>
 
 #include "brdfs/brdf.h"
-#include "factor/homomorphic_fit.h"
-#include "factor/lighting.h"
-#include "factor/model_fit.h"
-#include "factor/refine.h"
-#include "factor/sh_baseline.h"
-#include "factor/svd_baseline.h"
-#include "search/term_search.h"
+#include "factor/size_choice.h"
 
 namespace bf {
 
 class MethodKind;  // experiments/methods/method_kind.h
+struct ShLighting;  // factor/lighting.h
 
 // Every problem found in a config, one line each, formatted
 // "<file>:<line>: <field>: <rule, expected, found>" (or "-D key=value: <field>: ..."
@@ -100,7 +95,9 @@ struct SamplingVariant {
 };
 
 // One [[method]] variant. Its kind (experiments/methods/) reads and runs it;
-// only the kind looks at its typed options.
+// only the kind looks at its typed options, which it keeps in `typed` (its own
+// struct, e.g. HomomorphicOptions of methods/homomorphic.h, read through
+// kind_options<T>). The fields here are the ones every part of a run reads.
 struct MethodVariant {
   std::string kind;         // a registered kind's name (`brdf-factor list methods`)
   const MethodKind* impl = nullptr;  // that kind
@@ -109,35 +106,41 @@ struct MethodVariant {
   std::string where;        // "file:line" of its [[method]] table
   nlohmann::json options;   // every effective option with its default filled in (hashed)
   nlohmann::json execution; // options that do not change results (threads): recorded, not hashed
-  // Typed options, filled by the kind's reader (those of the kind are
-  // meaningful). A kind with options of its own type keeps them in `extra`.
+  // Size: terms and texels per texture edge, for the kinds that have them
+  // (the preflight's disk estimate reads them too).
   int texture_size = 16;
   int terms = 2;
-  Parameterization param = Parameterization::WiWo;
-  bool reciprocity = false;
-  FitOptions fit;                    // mccool, fit, search (search.fit mirrors it)
-  std::vector<TermSpec> projections; // fit: all configured projections at texture_size
-  SearchOptions search;
-  SvdOptions svd;
-  ShkOptions shk;
-  ShrOptions shr;
-  bool shrm = false;                 // sh-r: also the SHRM under the scene's SH lighting
-  std::optional<Tolerance> tolerance;  // fit, svd, sh-k, sh-r
-  // mccool, fit, search: "none" | "linear" | "cosine" | "blend" (factor/refine.h),
-  // the refinement stage run after the fit (refine_blend, refine_iterations,
-  // refine_smoothing fill refine_options).
-  std::string refine = "none";
-  RefineOptions refine_options;
-  bool sampling = false;  // `sampling` key: build (and export) the importance sampler (experiments/run/sampling_run.h)
-  ModelFitOptions model_fit;           // model-fit
+  std::optional<Tolerance> tolerance;  // fit, svd, sh-k, sh-r, mccool
   int cap = 0;              // with a tolerance: the largest terms / order tried
   // texture_size = "auto" (mccool, fit, svd; needs a tolerance): the
   // resolutions tried, ascending (key texture_ladder); empty = fixed texture_size.
   std::vector<int> texture_ladder;
-  uint64_t seed = 0;        // search seed (0 when the kind has none)
+  // Common keys (methods/catalogue.cpp): the refinement stage after a
+  // homomorphic fit, "none" | "linear" | "cosine" | "blend" (factor/refine.h;
+  // its options are the kind's), and whether to build and export the
+  // importance sampler (experiments/run/sampling_run.h).
+  std::string refine = "none";
+  bool sampler = false;
+  uint64_t seed = 0;        // the kind's seed (0 when the kind has none)
   int cores = 1;            // cores the method keeps busy by itself (scheduling, runner.h)
-  std::any extra;           // options of a kind that has no field above
+  std::any typed;           // the kind's own options (kind_options<T>)
 };
+
+// The kind's typed options of m. The mutable form creates a T{} the first
+// time (a kind's reader); both throw std::logic_error, naming the method, when
+// m holds options of another type (a kind reading another kind's variant).
+template <class T>
+T& kind_options(MethodVariant& m) {
+  if (!m.typed.has_value()) m.typed = T{};
+  if (T* t = std::any_cast<T>(&m.typed)) return *t;
+  throw std::logic_error("method \"" + m.label + "\" (kind " + m.kind + "): options of another type than asked");
+}
+template <class T>
+const T& kind_options(const MethodVariant& m) {
+  if (const T* t = std::any_cast<T>(&m.typed)) return *t;
+  throw std::logic_error("method \"" + m.label + "\" (kind " + m.kind + "): " +
+                         (m.typed.has_value() ? "options of another type than asked" : "no typed options were read"));
+}
 
 struct PlannedRun {
   std::string run_id;       // 12 hex digits of the identity's hash

@@ -3,6 +3,7 @@
 
 #include "brdfs/temp_file.h"
 #include "factor/image_io.h"
+#include "factor/lighting.h"
 
 #include <algorithm>
 #include <cmath>

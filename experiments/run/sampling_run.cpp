@@ -27,7 +27,7 @@ void run_sampling(const Brdf& result, bool export_files, const std::filesystem::
                       [&](std::ostream& out) { out << entry.dump(2) << "\n"; });
   }
   entry["build_seconds"] = seconds;
-  record["sampling"] = entry;
+  record["sampler"] = entry;
 }
 
 }  // namespace bf

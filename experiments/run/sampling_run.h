@@ -1,7 +1,7 @@
-// `[[method]] sampling = true`: the importance sampler of a run's result
+// `[[method]] sampler = true`: the importance sampler of a run's result
 // (factor/sampling.h, default SamplerOptions), its columns sampler_storage
 // (floats a renderer holds to sample) and sampler_build_s (seconds to build
-// it), its run.json entry "sampling", and with export on its files in the run
+// it), its run.json entry "sampler", and with export on its files in the run
 // folder: sampling.exr (the table), sampling.glsl (brdf_factor_sample,
 // brdf_factor_pdf) and sampling.json (the sidecar entry; docs/design.md,
 // "Importance sampling"). The exported sampler is always the table (the

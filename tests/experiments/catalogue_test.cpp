@@ -3,6 +3,7 @@
 // are the catalogue's; a kind added at run time needs nothing but its class
 // and one registration line.
 #include "experiments/methods/method_kind.h"
+#include "factor/sh_baseline.h"
 #include "experiments_helpers.h"
 
 using namespace bf;
@@ -108,7 +109,7 @@ class ToyConstantKind final : public MethodKind {
   void read(Reader& r, MethodVariant& m, nlohmann::json& o, uint64_t) const override {
     const double scale = r.number(keys()[0], 1.0);
     o["scale"] = scale;
-    m.extra = scale;
+    kind_options<double>(m) = scale;
   }
   MethodOutcome run(const RunContext& c) const override {
     Rgb sum = Rgb::Zero();
@@ -116,7 +117,7 @@ class ToyConstantKind final : public MethodKind {
     for (size_t i = 0; i < c.samples.size(); ++i)
       if (c.samples.valid[i]) sum += c.samples.value[i], n += 1;
     MethodOutcome out;
-    out.result = std::make_shared<ConstantFactorization>(sum / n * std::any_cast<double>(c.method.extra));
+    out.result = std::make_shared<ConstantFactorization>(sum / n * kind_options<double>(c.method));
     return out;
   }
   void fill_row(const RunContext&, MethodOutcome&, Row& row) const override { row["terms"] = "1"; }

@@ -2,6 +2,8 @@
 #include <algorithm>
 
 #include "experiments/config/config.h"
+#include "experiments/methods/homomorphic.h"
+#include "factor/svd_baseline.h"
 #include "experiments/methods/method_kind.h"
 #include "experiments_helpers.h"
 
@@ -38,7 +40,7 @@ restarts = 1
   CHECK(p.experiment.name == "t");
   CHECK(p.experiment.out == "results/t");
   CHECK(p.methods[0].kind == "mccool");
-  CHECK(p.methods[1].search.restarts == 1);
+  CHECK(homomorphic_options(p.methods[1]).search.restarts == 1);
   CHECK(p.methods[1].seed == 1);  // experiment.seed by default
   CHECK(p.runs[0].run_id.size() == 12);
   CHECK(p.runs[0].run_id != p.runs[1].run_id);
@@ -183,10 +185,10 @@ restarts = 1
   REQUIRE(p.methods.size() == 6);
   REQUIRE(p.runs.size() == 6);
   // parameterization comes first in the file: it is the outer loop.
-  CHECK(p.methods[0].param == Parameterization::WiWo);
+  CHECK(homomorphic_options(p.methods[0]).param == Parameterization::WiWo);
   CHECK(p.methods[0].terms == 1);
   CHECK(p.methods[2].terms == 3);
-  CHECK(p.methods[3].param == Parameterization::HalfDiff);
+  CHECK(homomorphic_options(p.methods[3]).param == Parameterization::HalfDiff);
   CHECK(p.methods[3].terms == 1);
 }
 
@@ -202,9 +204,9 @@ zip = ["terms", "texture_size"]
   REQUIRE(p.methods.size() == 6);
   CHECK(p.methods[0].terms == 1);
   CHECK(p.methods[0].texture_size == 8);
-  CHECK(p.methods[0].param == Parameterization::WiWo);
+  CHECK(kind_options<SvdOptions>(p.methods[0]).param == Parameterization::WiWo);
   CHECK(p.methods[1].terms == 1);
-  CHECK(p.methods[1].param == Parameterization::HalfDiff);
+  CHECK(kind_options<SvdOptions>(p.methods[1]).param == Parameterization::HalfDiff);
   CHECK(p.methods[4].terms == 4);
   CHECK(p.methods[4].texture_size == 16);
   SECTION("unequal lengths are an error") {
@@ -266,14 +268,14 @@ restarts = 6
     const Plan p = plan_of(text, {"method.restarts=1", "method.texture_size=8"});
     CHECK(p.methods[0].texture_size == 8);
     CHECK(p.methods[1].texture_size == 8);
-    CHECK(p.methods[1].search.restarts == 1);
+    CHECK(homomorphic_options(p.methods[1]).search.restarts == 1);
   }
   SECTION("method[N].KEY reaches one method; a list becomes a sweep") {
     const Plan p = plan_of(text, {"method[1].terms=[1, 2]", "method[1].parameterization=halfdiff"});
     REQUIRE(p.methods.size() == 3);
     CHECK(p.methods[1].terms == 1);
     CHECK(p.methods[2].terms == 2);
-    CHECK(p.methods[2].param == Parameterization::HalfDiff);
+    CHECK(homomorphic_options(p.methods[2]).param == Parameterization::HalfDiff);
   }
   SECTION("a new section") {
     const Plan p = plan_of(text, {"scene.size=32"});
@@ -360,19 +362,36 @@ TEST_CASE("config: non-greedy search keys (beam, backfit) are read, validated, a
   const std::string greedy = std::string(kBase) + "[[method]]\nkind = \"search\"\nstrategy = \"greedy\"\nrestarts = 3\n";
   const Plan g = plan_of(greedy);
   // Without a strategy, a greedy-only key selects the greedy search (the default is "best").
-  CHECK(plan_of(std::string(kBase) + "[[method]]\nkind = \"search\"\nrestarts = 3\n").methods[0].search.strategy ==
+  CHECK(homomorphic_options(plan_of(std::string(kBase) + "[[method]]\nkind = \"search\"\nrestarts = 3\n").methods[0]).search.strategy ==
         "best");
-  CHECK(plan_of(std::string(kBase) + "[[method]]\nkind = \"search\"\nbeam = 1\n").methods[0].search.strategy ==
+  CHECK(homomorphic_options(plan_of(std::string(kBase) + "[[method]]\nkind = \"search\"\nbeam = 1\n").methods[0]).search.strategy ==
         "greedy");
   const Plan g1 = plan_of(greedy + "beam = 1\nbackfit_sweeps = 0\n");
   CHECK(g.runs[0].run_id == g1.runs[0].run_id);  // defaults do not change the id (cache kept)
   const Plan p = plan_of(greedy + "beam = 2\nbackfit_sweeps = [0, 3]\nbackfit_restarts = 1\n");
   REQUIRE(p.methods.size() == 2);
-  CHECK(p.methods[0].search.beam == 2);
-  CHECK(p.methods[1].search.backfit_sweeps == 3);
-  CHECK(p.methods[1].search.backfit_restarts == 1);
+  CHECK(homomorphic_options(p.methods[0]).search.beam == 2);
+  CHECK(homomorphic_options(p.methods[1]).search.backfit_sweeps == 3);
+  CHECK(homomorphic_options(p.methods[1]).search.backfit_restarts == 1);
   CHECK(p.runs[0].run_id != g.runs[0].run_id);
   CHECK(p.runs[0].run_id != p.runs[1].run_id);
   require_one_config_error(greedy + "beam = 4\n", {"cfg.toml:", "method[0]", "beam", "1..3", "found 4"});
   require_one_config_error(greedy + "backfit_sweeps = -1\n", {"cfg.toml:", "method[0].backfit_sweeps", "found -1"});
+}
+
+TEST_CASE("config: a kind's typed options are its own and another kind's type is refused naming the method") {
+  const Plan p = plan_of(std::string(kBase) + "[[method]]\nkind = \"svd\"\nterms = 3\nlabel = \"mine\"\n");
+  CHECK(kind_options<SvdOptions>(p.methods[0]).rank == 3);
+  try {
+    (void)homomorphic_options(p.methods[0]);
+    FAIL("reading svd's options as HomomorphicOptions did not throw");
+  } catch (const std::logic_error& e) {
+    const std::string what = e.what();
+    CHECK(what.find("mine") != std::string::npos);
+    CHECK(what.find("svd") != std::string::npos);
+    CHECK(what.find("another type") != std::string::npos);
+  }
+  MethodVariant empty;
+  empty.kind = "svd";
+  CHECK_THROWS_AS(kind_options<SvdOptions>(static_cast<const MethodVariant&>(empty)), std::logic_error);
 }

@@ -76,7 +76,7 @@ class ToyTintKind final : public MethodKind {
   void read(Reader& r, MethodVariant& m, nlohmann::json& o, uint64_t) const override {
     const double gain = r.number(keys()[0], 1.0);
     o["gain"] = gain;
-    m.extra = gain;
+    kind_options<double>(m) = gain;
   }
   MethodOutcome run(const RunContext& c) const override {
     Rgb sum = Rgb::Zero();
@@ -84,7 +84,7 @@ class ToyTintKind final : public MethodKind {
     for (size_t i = 0; i < c.samples.size(); ++i)
       if (c.samples.valid[i]) sum += c.samples.value[i], n += 1;
     MethodOutcome out;
-    out.result = std::make_shared<TintFactorization>(sum / n * std::any_cast<double>(c.method.extra));
+    out.result = std::make_shared<TintFactorization>(sum / n * kind_options<double>(c.method));
     return out;
   }
   void fill_row(const RunContext&, MethodOutcome&, Row&) const override {}

@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include "experiments/config/config.h"
+#include "experiments/methods/homomorphic.h"
 #include "experiments/report/outputs.h"
 #include "factor/metrics.h"
 #include "factor/model_fit.h"
@@ -53,20 +54,20 @@ refine_smoothing = 0.5
   REQUIRE(p.methods.size() == 6);
   CHECK(p.methods[0].refine == "none");
   CHECK(p.methods[1].refine == "linear");
-  CHECK(p.methods[1].refine_options.objective == "linear");
-  CHECK(p.methods[1].refine_options.max_iterations == 7);
-  CHECK(p.methods[2].refine_options.objective == "cosine");
-  CHECK(p.methods[3].refine_options.blend_weight == 0.1);
+  CHECK(homomorphic_options(p.methods[1]).refine.objective == "linear");
+  CHECK(homomorphic_options(p.methods[1]).refine.max_iterations == 7);
+  CHECK(homomorphic_options(p.methods[2]).refine.objective == "cosine");
+  CHECK(homomorphic_options(p.methods[3]).refine.blend_weight == 0.1);
   // Refine keys are hashed only when a refinement runs; blend's weight only for blend.
   CHECK(!p.methods[0].options.contains("refine_blend"));
   CHECK(!p.methods[0].options.contains("refine_iterations"));
   CHECK(!p.methods[1].options.contains("refine_blend"));
   CHECK(p.methods[3].options.at("refine_blend") == 0.1);
   // Smoothing defaults to the fit's own.
-  CHECK(p.methods[1].refine_options.smoothing == p.methods[1].fit.smoothing);
+  CHECK(homomorphic_options(p.methods[1]).refine.smoothing == homomorphic_options(p.methods[1]).fit.smoothing);
   CHECK(p.methods[4].refine == "blend");
-  CHECK(p.methods[4].refine_options.blend_weight == RefineOptions{}.blend_weight);
-  CHECK(p.methods[5].refine_options.smoothing == 0.5);
+  CHECK(homomorphic_options(p.methods[4]).refine.blend_weight == RefineOptions{}.blend_weight);
+  CHECK(homomorphic_options(p.methods[5]).refine.smoothing == 0.5);
   // Every variant is its own run; a refine = "none" run's id does not depend on refine keys.
   CHECK(p.runs.size() == 6);
   const Plan q = parse_plan(std::string(kBase) + "[[method]]\nkind = \"mccool\"\n", "cfg.toml");

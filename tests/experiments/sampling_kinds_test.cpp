@@ -77,7 +77,7 @@ TEST_CASE("sampling: every kind's sampler passes chi2 on Cook-Torrance and a Cor
   check_every_kind("model = \"krylon-blue\"", 1000000);
 }
 
-TEST_CASE("sampling: sampling = true builds the sampler and writes its export and columns") {
+TEST_CASE("sampling: sampler = true builds the sampler and writes its export and columns") {
   ScratchDir tmp;
   const std::string cfg = write_text(tmp / "cfg.toml", R"([experiment]
 name = "t"
@@ -94,7 +94,7 @@ resolution = 6
 [[method]]
 kind = "sh-k"
 order = 2
-sampling = true
+sampler = true
 
 [[method]]
 kind = "sh-k"
@@ -131,7 +131,10 @@ order = 2
       CHECK((got->sample(wo, u, 1 - u).wi - want->sample(wo, u, 1 - u).wi).norm() < 1e-5);
     }
     const nlohmann::json rec = nlohmann::json::parse(slurp((run / "run.json").string()));
-    CHECK(rec.contains("sampling"));
+    REQUIRE(rec.contains("sampler"));
+    CHECK(rec["sampler"].contains("cosine_fraction"));
+    // run.json's "sampling" stays the sample set's description.
+    CHECK(rec.at("sampling") == "grid 6^4");
   }
 }
 

@@ -3,6 +3,7 @@
 #include <catch2/catch.hpp>
 
 #include "experiments/report/scene_weights.h"
+#include "factor/lighting.h"
 #include "experiments_helpers.h"
 
 using namespace bf;

@@ -6,6 +6,7 @@
 #include <map>
 #include <set>
 
+#include "experiments/methods/homomorphic.h"
 #include "experiments/report/outputs.h"
 #include "experiments_helpers.h"
 #include "factor/export.h"
@@ -124,15 +125,15 @@ TEST_CASE("search parameterization: the options say fixed exactly when the key i
                                    "parameterization = \"halfdiff\"\nterm_param = \"fixed\"\n",
                                "cfg.toml");
   REQUIRE(plan.methods.size() == 5);
-  CHECK(plan.methods[0].search.term_param == "fixed");
-  CHECK(plan.methods[0].search.param == Parameterization::WiWo);
-  CHECK(plan.methods[1].search.term_param == "fixed");
-  CHECK(plan.methods[1].search.param == Parameterization::HalfDiff);
-  CHECK(plan.methods[2].search.term_param == "either");  // no key: the search chooses
-  CHECK(plan.methods[3].search.term_param == "fixed");
-  CHECK(plan.methods[3].search.param == Parameterization::WiWo);
-  CHECK(plan.methods[4].search.term_param == "fixed");
-  CHECK(plan.methods[4].search.param == Parameterization::HalfDiff);
+  CHECK(homomorphic_options(plan.methods[0]).search.term_param == "fixed");
+  CHECK(homomorphic_options(plan.methods[0]).search.param == Parameterization::WiWo);
+  CHECK(homomorphic_options(plan.methods[1]).search.term_param == "fixed");
+  CHECK(homomorphic_options(plan.methods[1]).search.param == Parameterization::HalfDiff);
+  CHECK(homomorphic_options(plan.methods[2]).search.term_param == "either");  // no key: the search chooses
+  CHECK(homomorphic_options(plan.methods[3]).search.term_param == "fixed");
+  CHECK(homomorphic_options(plan.methods[3]).search.param == Parameterization::WiWo);
+  CHECK(homomorphic_options(plan.methods[4]).search.term_param == "fixed");
+  CHECK(homomorphic_options(plan.methods[4]).search.param == Parameterization::HalfDiff);
   // The run id tells a fixed search from a free one.
   CHECK(plan.methods[0].options.dump() != plan.methods[2].options.dump());
 }

@@ -5,6 +5,8 @@
 #include <algorithm>
 
 #include "experiments/config/config.h"
+#include "experiments/methods/homomorphic.h"
+#include "factor/svd_baseline.h"
 #include "experiments_helpers.h"
 
 using namespace bf;
@@ -47,7 +49,7 @@ texture_size = 12
   CHECK(mc.tolerance.has_value());
   CHECK(p.methods[2].texture_ladder.empty());
   CHECK(p.methods[2].options["texture_size"] == 12);
-  CHECK(p.methods[2].svd.res == 12);
+  CHECK(kind_options<SvdOptions>(p.methods[2]).res == 12);
 }
 
 TEST_CASE("config: texture_size = \"auto\" misuse names the key") {
@@ -84,7 +86,7 @@ tolerance = { metric = "cos_rmse", value = 0.01 }
 )"), "cfg.toml");
   REQUIRE(p.methods.size() == 2);
   CHECK(p.methods[0].cap == 8);
-  CHECK(p.methods[0].search.terms == 8);
+  CHECK(homomorphic_options(p.methods[0]).search.terms == 8);
   CHECK(p.methods[0].options["tolerance"]["metric"] == "rel_mse");
   CHECK(p.methods[1].cap == 3);
   require_error("kind = \"search\"\nbeam = 2\ntolerance = { metric = \"rel_mse\", value = 0.05 }\n",

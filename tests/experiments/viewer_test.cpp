@@ -18,6 +18,7 @@
 #include "experiments/config/config.h"
 #include "experiments/methods/method_kind.h"
 #include "experiments/report/render.h"
+#include "factor/lighting.h"
 #include "experiments_helpers.h"
 
 using namespace bf;
