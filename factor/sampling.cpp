@@ -294,6 +294,36 @@ std::shared_ptr<const BrdfSampler> model_sampler(const Brdf& f, const SamplerOpt
   return std::make_shared<BeckmannSampler>(p.m, w_cos);
 }
 
+// Adds to cell[r * P + c] the integral of max(0, Y(f)) cos theta_i over
+// the cell (r, c) of wi for wo at (theta_o, phi_o): cells relative to phi_o, a
+// cell_samples^2 midpoint rule uniform in 1 - cos theta_i and phi_i.
+void add_cell_weights(const Brdf& f, double to, double po, const SamplerGeometry& geo, int T, int P, int S,
+                      std::vector<double>& cell) {
+  const Vec3 wo(std::sin(to) * std::cos(po), std::sin(to) * std::sin(po), std::cos(to));
+  for (int r = 0; r < T; ++r) {
+    const double oa = geo.row_omc[r], ob = geo.row_omc[r + 1];
+    for (int c = 0; c < P; ++c) {
+      double sum = 0;
+      for (int i = 0; i < S; ++i) {
+        const double omc = oa + (ob - oa) * (i + 0.5) / S, ct = 1.0 - omc;
+        const double st = std::sqrt(std::max(0.0, omc * (2.0 - omc)));
+        for (int j = 0; j < S; ++j) {
+          const double phi = po + (c + (j + 0.5) / S) * kTwoPi / P;
+          const Vec3 wi(st * std::cos(phi), st * std::sin(phi), ct);
+          const double y = luminance(f.eval(wi, wo));
+          if (std::isfinite(y) && y > 0) sum += y * ct;
+        }
+      }
+      // Solid angle of the cell: (ob - oa) 2 pi / P.
+      cell[static_cast<size_t>(r) * P + c] += sum / (S * S) * (ob - oa) * kTwoPi / P;
+    }
+  }
+}
+
+// View azimuths averaged into the single table of a BRDF that does not say
+// it is isotropic when view_phi_bins = 1.
+constexpr int kIsoAzimuths = 8;
+
 void require(bool ok, const char* field, const std::string& rule, double value) {
   if (!ok) {
     throw OptionError(field, std::string("sampler option ") + field + ": " + rule + ", found " +
@@ -347,28 +377,16 @@ std::shared_ptr<const BrdfSampler> make_sampler(const Brdf& f, const SamplerOpti
       const int v = vt * t.view_phi_bins + vp;
       // The bin centre: theta_o = (vt + 1/2) pi / (2 view_bins), phi_o = 2 pi vp / view_phi_bins.
       const double to = (vt + 0.5) * kHalfPi / t.view_bins, po = vp * kTwoPi / t.view_phi_bins;
-      const Vec3 wo(std::sin(to) * std::cos(po), std::sin(to) * std::sin(po), std::cos(to));
+      // A BRDF that does not say it is isotropic, given one azimuth bin: the
+      // mean of f cos over kIsoAzimuths view azimuths (the best single table
+      // of, e.g., a factorization of an isotropic BRDF).
+      const int na = (t.view_phi_bins == 1 && !f.isotropic()) ? kIsoAzimuths : 1;
+      std::fill(cell.begin(), cell.end(), 0.0);
+      for (int k = 0; k < na; ++k) add_cell_weights(f, to, po + k * kTwoPi / na, geo, T, P, S, cell);
       double total = 0;
       for (int r = 0; r < T; ++r) {
-        const double oa = geo.row_omc[r], ob = geo.row_omc[r + 1];
         row[r] = 0;
-        for (int c = 0; c < P; ++c) {
-          double sum = 0;
-          for (int i = 0; i < S; ++i) {
-            const double omc = oa + (ob - oa) * (i + 0.5) / S, ct = 1.0 - omc;
-            const double st = std::sqrt(std::max(0.0, omc * (2.0 - omc)));
-            for (int j = 0; j < S; ++j) {
-              const double phi = po + (c + (j + 0.5) / S) * kTwoPi / P;
-              const Vec3 wi(st * std::cos(phi), st * std::sin(phi), ct);
-              const double y = luminance(f.eval(wi, wo));
-              if (std::isfinite(y) && y > 0) sum += y * ct;
-            }
-          }
-          // Integral of f cos over the cell (solid angle (ca - cb) 2 pi / P).
-          const double w = sum / (S * S) * (ob - oa) * kTwoPi / P;
-          cell[static_cast<size_t>(r) * P + c] = w;
-          row[r] += w;
-        }
+        for (int c = 0; c < P; ++c) row[r] += cell[static_cast<size_t>(r) * P + c];
         total += row[r];
       }
       if (!(total > 0) || !std::isfinite(total)) continue;

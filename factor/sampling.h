@@ -46,6 +46,8 @@ struct SamplerOptions {
   int phi_bins = 64;
   // Bins of the view azimuth phi_o over [0, 2 pi) (nearest bin). 0 = 1 for a
   // BRDF that says it is isotropic (Brdf::isotropic()), else 16. 0..256.
+  // 1 for a BRDF that does not say it is isotropic (a factorization of an
+  // isotropic BRDF): the table is the mean of f cos over 8 view azimuths.
   int view_phi_bins = 0;
   // Probability of drawing wi from the cosine lobe cos(theta_i) / pi instead
   // of the table: keeps the pdf positive over the whole hemisphere. (0, 1);

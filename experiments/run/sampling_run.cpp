@@ -9,10 +9,11 @@
 
 namespace bf {
 
-void run_sampling(const Brdf& result, bool export_files, const std::filesystem::path& run_dir, Row& row,
-                  nlohmann::json& record) {
+void run_sampling(const Brdf& result, bool fitted_isotropic, bool export_files, const std::filesystem::path& run_dir,
+                  Row& row, nlohmann::json& record) {
   SamplerOptions o;
   o.method = "tabulated";
+  if (fitted_isotropic) o.view_phi_bins = 1;
   const auto t0 = std::chrono::steady_clock::now();
   const auto s = make_sampler(result, o);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
