@@ -106,8 +106,8 @@ void add_cmd_mc_variance(CLI::App& app) {
       // the approximation of it too (the same integrand compared with three samplers).
       if (dynamic_cast<const CookTorrance*>(integrands[0].f.get()))
         samplers.push_back({"model", make_sampler(*integrands[0].f)});
-      for (const LightSampler* ls : {static_cast<const LightSampler*>(nullptr), light.get()}) {
-        if (ls != nullptr && !a->mis) continue;
+      for (int pass = 0; pass < (light ? 2 : 1); ++pass) {
+        const LightSampler* ls = pass == 1 ? light.get() : nullptr;
         const std::string suffix = ls ? "+light" : "";
         double cos_var = 0;
         for (const auto& [name, s] : samplers) {

@@ -7,6 +7,7 @@
 #include "brdfs/catalogue.h"
 #include "brdfs/models.h"
 #include "experiments/report/mc_render.h"
+#include "experiments_helpers.h"
 #include "factor/lighting.h"
 
 using namespace bf;
@@ -159,4 +160,24 @@ TEST_CASE("mc render: with light sampling the render stays unbiased and a narrow
   CHECK(r > 0.6);
   CHECK(r < 1.6);
   CHECK(mis.pixel_variance() < 0.5 * plain.pixel_variance());
+}
+
+TEST_CASE("mc render: mc-variance prints one row per sampler and with --mis one more per sampler") {
+  auto rows = [](const std::string& out) {
+    std::vector<std::string> names;
+    std::istringstream in(out);
+    std::string integrand, sampler, rest;
+    while (in >> integrand >> sampler && std::getline(in, rest))
+      if (integrand != "integrand") names.push_back(integrand + " " + sampler);
+    return names;
+  };
+  std::string out;
+  REQUIRE(bf_test::run_cli("mc-variance --brdf cook-torrance:m=0.2 --order 2 --spp 4 --size 8", &out) == 0);
+  CHECK(rows(out) == std::vector<std::string>{"original cosine", "original tabulated", "original model"});
+  REQUIRE(bf_test::run_cli("mc-variance --brdf cook-torrance:m=0.2 --order 2 --spp 4 --size 8 --mis", &out) == 0);
+  CHECK(rows(out) == std::vector<std::string>{"original cosine", "original tabulated", "original model",
+                                              "original cosine+light", "original tabulated+light",
+                                              "original model+light"});
+  CHECK(bf_test::run_cli("mc-variance --brdf lambert --order 2 --view-phi-bins 300", &out) == 2);
+  CHECK_THAT(out, Catch::Contains("--view-phi-bins") && Catch::Contains("300"));
 }
