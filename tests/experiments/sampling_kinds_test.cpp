@@ -5,6 +5,7 @@
 // three views), on bluepaint, Cook-Torrance m = 0.2 and the Cornell paint
 // krylon-blue.
 #include <cmath>
+#include <map>
 
 #include "brdfs/catalogue.h"
 #include "experiments/methods/method_kind.h"
@@ -186,6 +187,58 @@ sampling = true
     }
     CHECK(sidak(pmin, 3) > 0.01);
   }
+}
+
+// A run with sampling on records its Monte Carlo noise against samples
+// (cosine and its own sampler at 4, 16, 64 spp) in run.json; with plots,
+// report.html shows it (plot_results.py: noise_vs_spp).
+namespace {
+void check_noise_rows(bool plots) {
+  ScratchDir tmp;
+  const std::string cfg = write_text(tmp / "cfg.toml", R"([experiment]
+name = "t"
+render = false
+
+[[brdf]]
+preset = "bluepaint"
+
+[sampling]
+kind = "grid"
+resolution = 6
+
+[[method]]
+kind = "sh-k"
+order = 2
+sampling = true
+)");
+  const RunSummary s = run_quiet(cfg, tmp / "out", {}, plots);
+  REQUIRE(s.failed == 0);
+  const auto rows = read_results_csv(tmp / "out/results.csv");
+  REQUIRE(rows.size() == 1);
+  const nlohmann::json rec =
+      nlohmann::json::parse(slurp((fs::path(tmp / "out/runs") / rows[0].at("run_id") / "run.json").string()));
+  const nlohmann::json& noise = rec.at("sampling").at("noise");
+  REQUIRE(noise.size() == 6);
+  std::map<std::string, std::vector<double>> rmse;
+  for (const auto& n : noise) rmse[n.at("sampler").get<std::string>()].push_back(n.at("rmse").get<double>());
+  for (const auto& [sampler, r] : rmse) {
+    INFO(sampler);
+    REQUIRE(r.size() == 3);
+    for (double v : r) CHECK((std::isfinite(v) && v > 0));
+    CHECK(r[2] < r[0]);  // 16x the samples: less noise
+  }
+  if (!plots) return;
+  CHECK(fs::exists(tmp / "out/plots/noise_vs_spp.png"));
+  CHECK(slurp(tmp / "out/report.html").find("plots/noise_vs_spp.png") != std::string::npos);
+}
+}  // namespace
+
+TEST_CASE("sampling: a run with sampling on records its Monte Carlo noise against samples") {
+  check_noise_rows(false);
+}
+
+TEST_CASE("sampling: report.html shows the noise against samples of a run with sampling on", "[slow]") {
+  check_noise_rows(true);
 }
 
 TEST_CASE("sampling: sample-dirs prints n samples and names bad arguments") {
