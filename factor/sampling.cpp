@@ -32,14 +32,6 @@ double cosine_pdf(const Vec3& wi) { return wi.z() > 0 ? wi.z() / kPi : 0.0; }
 
 bool above(const Vec3& w) { return w.z() > 0 && std::isfinite(w.z()) && std::isfinite(w.x()) && std::isfinite(w.y()); }
 
-// The azimuth of w in [0, 2 pi).
-double azimuth(const Vec3& w) {
-  if (w.x() == 0 && w.y() == 0) return 0.0;  // (atan2(-0, -0) is -pi)
-  double p = std::atan2(w.y(), w.x());
-  if (p < 0) p += kTwoPi;
-  return p >= kTwoPi ? 0.0 : p;
-}
-
 class CosineSampler final : public BrdfSampler {
  public:
   DirectionSample sample(const Vec3& wo, double u1, double u2) const override {
@@ -65,9 +57,42 @@ int find_interval(const float* cdf, int n, double u) {
   return lo;
 }
 
+// The unit direction of w's projection on the xy plane, (1, 0) on the pole:
+// the x axis of the frame in which wi's azimuth is relative to wo's.
+Vec3 azimuth_axis(const Vec3& w) {
+  const double r = std::hypot(w.x(), w.y());
+  return r > 0 ? Vec3(w.x() / r, w.y() / r, 0.0) : Vec3(1.0, 0.0, 0.0);
+}
+
+// 1 - cos theta of a unit direction, precise also near the normal.
+double one_minus_cos(const Vec3& w) {
+  return w.z() >= 0.5 ? (w.x() * w.x() + w.y() * w.y()) / (1.0 + w.z()) : 1.0 - w.z();
+}
+
+// Index k in [0, n) of the wedge [2 pi k / n, 2 pi (k + 1) / n) holding the
+// angle of (x, y) (not both 0): a guess from atan2, corrected by the sign of
+// the cross product with the wedge's edges (so the GLSL, whose atan is an
+// approximation, finds the same wedge).
+int wedge(double x, double y, int n) {
+  double a = std::atan2(y, x);
+  if (a < 0) a += kTwoPi;
+  int k = static_cast<int>(a / kTwoPi * n);
+  k = ((k % n) + n) % n;
+  for (int it = 0; it < 2; ++it) {
+    const double e0 = k * kTwoPi / n, e1 = (k + 1) * kTwoPi / n;
+    if (std::cos(e0) * y - std::sin(e0) * x < 0) k = (k + n - 1) % n;
+    else if (std::cos(e1) * y - std::sin(e1) * x >= 0) k = (k + 1) % n;
+    else break;
+  }
+  return k;
+}
+
 class TabulatedSampler final : public BrdfSampler {
  public:
-  explicit TabulatedSampler(SamplerTable t) : t_(std::move(t)) {}
+  explicit TabulatedSampler(SamplerTable t) : t_(std::move(t)) {
+    const SamplerGeometry g = sampler_geometry(t_);
+    view_cos_ = g.view_cos, row_omc_ = g.row_omc;
+  }
 
   DirectionSample sample(const Vec3& wo, double u1, double u2) const override {
     if (!above(wo)) return {};
@@ -89,12 +114,20 @@ class TabulatedSampler final : public BrdfSampler {
     const float* cc = &t_.col_cdf[(static_cast<size_t>(v) * T + r) * (P + 1)];
     const int c = find_interval(cc, P, u2);
     const double v2 = clamp_u((u2 - cc[c]) / (static_cast<double>(cc[c + 1]) - cc[c]));
-    const double ca = std::cos(r * kHalfPi / T), cb = std::cos((r + 1) * kHalfPi / T);
-    const double ct = ca + (cb - ca) * v1;
-    const double st = std::sqrt(std::max(0.0, 1.0 - ct * ct));
-    const double phi = azimuth(wo) + (c + v2) * kTwoPi / P;
-    const Vec3 wi(st * std::cos(phi), st * std::sin(phi), ct);
-    return {wi, pdf_mix(m, wi, wo)};
+    // 1 - cos theta_i, uniform in the row (precise near the normal too).
+    const double oa = row_omc_[r], ob = row_omc_[r + 1];
+    const double omc = oa + (ob - oa) * v1, ct = 1.0 - omc;
+    const double st = std::sqrt(std::max(0.0, omc * (2.0 - omc)));
+    const double phi = (c + v2) * kTwoPi / P;  // relative to wo's azimuth
+    const Vec3 ex = azimuth_axis(wo), ey(-ex.y(), ex.x(), 0.0);
+    const double cp = std::cos(phi), sp = std::sin(phi);
+    const Vec3 wi(st * (cp * ex.x() + sp * ey.x()), st * (cp * ex.y() + sp * ey.y()), ct);
+    // The density at wi in the cell it was drawn from (a recomputed cell can
+    // differ on the cell's edge by rounding).
+    double p = m.w_cos * cosine_pdf(wi);
+    if (m.w_a > 0) p += m.w_a * cell_pdf(m.va, r, c);
+    if (m.w_b > 0) p += m.w_b * cell_pdf(m.vb, r, c);
+    return {wi, wi.z() > 0 ? p : 0.0};
   }
 
   double pdf(const Vec3& wi, const Vec3& wo) const override {
@@ -110,47 +143,85 @@ class TabulatedSampler final : public BrdfSampler {
     int va = 0, vb = 0;
     double w_cos = 1, w_a = 0, w_b = 0;
   };
-  // Which view bins' tables, with which weights: linear in theta_o between
-  // the two nearest bin centres, nearest phi_o bin; an empty table's weight
-  // goes to the cosine lobe.
+  // Which view bins' tables, with which weights: linear in cos theta_o
+  // between the cosines of the two nearest bin centres (clamped at both
+  // ends), nearest phi_o bin; an empty table's weight goes to the cosine lobe.
   Mix mix(const Vec3& wo) const {
     const int V = t_.view_bins, VP = t_.view_phi_bins;
-    const double to = std::acos(std::min(1.0, std::max(0.0, wo.z())));
-    const double x = std::min(std::max(to / kHalfPi * V - 0.5, 0.0), V - 1.0);
-    const int a = std::min(static_cast<int>(x), V - 1), b = std::min(a + 1, V - 1);
-    const double t = x - a;
-    int vp = static_cast<int>(azimuth(wo) / kTwoPi * VP + 0.5);
-    if (vp >= VP) vp = 0;
+    const double z = wo.z();
+    int a = 0, b = 0;
+    double t = 0;
+    if (z >= view_cos_[0]) {
+      a = b = 0;
+    } else if (z <= view_cos_[V - 1]) {
+      a = b = V - 1;
+    } else {
+      // view_cos_ decreases: the last centre with cos >= z.
+      int lo = 0, hi = V - 1;  // view_cos_[lo] > z > view_cos_[hi]
+      while (hi - lo > 1) {
+        const int mid = (lo + hi) / 2;
+        if (view_cos_[mid] >= z) lo = mid; else hi = mid;
+      }
+      a = lo, b = hi;
+      t = (view_cos_[a] - z) / (view_cos_[a] - view_cos_[b]);
+    }
+    int vp = 0;
+    if (VP > 1 && (wo.x() != 0 || wo.y() != 0)) {
+      // Nearest bin centre 2 pi k / VP: the wedge of width 2 pi / VP starting
+      // half a bin earlier, i.e. wo's direction rotated by + pi / VP.
+      const double h = kPi / VP, c = std::cos(h), s = std::sin(h);
+      vp = wedge(c * wo.x() - s * wo.y(), s * wo.x() + c * wo.y(), VP);
+    }
     Mix m;
     m.va = a * VP + vp, m.vb = b * VP + vp;
     const double rest = 1.0 - t_.cosine_fraction;
-    m.w_a = t_.empty[m.va] ? 0.0 : rest * (1.0 - t);
-    m.w_b = t_.empty[m.vb] ? 0.0 : rest * t;
-    m.w_cos = 1.0 - m.w_a - m.w_b;
+    const double wa = rest * (1.0 - t), wb = rest * t;
+    m.w_a = t_.empty[m.va] ? 0.0 : wa;
+    m.w_b = t_.empty[m.vb] ? 0.0 : wb;
+    // cosine_fraction itself when both tables exist (not 1 - w_a - w_b: u1 is
+    // compared with it, and that sum would round differently in float).
+    m.w_cos = t_.cosine_fraction + (t_.empty[m.va] ? wa : 0.0) + (t_.empty[m.vb] ? wb : 0.0);
     return m;
   }
-  double table_pdf(int v, const Vec3& wi, const Vec3& wo) const {
+  // The table's density in cell (r, c) of view bin v.
+  double cell_pdf(int v, int r, int c) const {
     const int T = t_.theta_bins, P = t_.phi_bins;
-    const double ti = std::acos(std::min(1.0, wi.z()));
-    const int r = std::min(static_cast<int>(ti / kHalfPi * T), T - 1);
-    double pr = azimuth(wi) - azimuth(wo);
-    if (pr < 0) pr += kTwoPi;
-    const int c = std::min(static_cast<int>(pr / kTwoPi * P), P - 1);
     const float* rc = &t_.row_cdf[static_cast<size_t>(v) * (T + 1)];
     const float* cc = &t_.col_cdf[(static_cast<size_t>(v) * T + r) * (P + 1)];
     const double prob = (static_cast<double>(rc[r + 1]) - rc[r]) * (static_cast<double>(cc[c + 1]) - cc[c]);
-    const double ca = std::cos(r * kHalfPi / T), cb = std::cos((r + 1) * kHalfPi / T);
-    return prob / ((ca - cb) * kTwoPi / P);
+    return prob / ((row_omc_[r + 1] - row_omc_[r]) * kTwoPi / P);
+  }
+  // The cell of wi (above the horizon): theta row by comparing 1 - cos theta_i
+  // with the rows' edges, azimuth cell relative to wo's.
+  std::pair<int, int> cell_of(const Vec3& wi, const Vec3& wo) const {
+    const int T = t_.theta_bins, P = t_.phi_bins;
+    // row_omc_[r] <= omc < row_omc_[r + 1].
+    const double omc = one_minus_cos(wi);
+    int lo = 0, hi = T;
+    while (hi - lo > 1) {
+      const int mid = (lo + hi) / 2;
+      if (row_omc_[mid] <= omc) lo = mid; else hi = mid;
+    }
+    int c = 0;
+    if (wi.x() != 0 || wi.y() != 0) {
+      const Vec3 ex = azimuth_axis(wo);
+      c = wedge(wi.x() * ex.x() + wi.y() * ex.y(), wi.y() * ex.x() - wi.x() * ex.y(), P);
+    }
+    return {lo, c};
   }
   double pdf_mix(const Mix& m, const Vec3& wi, const Vec3& wo) const {
     if (!above(wi)) return 0.0;
     double p = m.w_cos * cosine_pdf(wi);
-    if (m.w_a > 0) p += m.w_a * table_pdf(m.va, wi, wo);
-    if (m.w_b > 0) p += m.w_b * table_pdf(m.vb, wi, wo);
+    if (m.w_a > 0 || m.w_b > 0) {
+      const auto [r, c] = cell_of(wi, wo);
+      if (m.w_a > 0) p += m.w_a * cell_pdf(m.va, r, c);
+      if (m.w_b > 0) p += m.w_b * cell_pdf(m.vb, r, c);
+    }
     return p;
   }
 
   SamplerTable t_;
+  std::vector<double> view_cos_, row_omc_;
 };
 
 // Cook-Torrance: a mixture of the cosine lobe (the diffuse term) and the
@@ -223,6 +294,36 @@ std::shared_ptr<const BrdfSampler> model_sampler(const Brdf& f, const SamplerOpt
   return std::make_shared<BeckmannSampler>(p.m, w_cos);
 }
 
+// Adds to cell[r * P + c] the integral of max(0, Y(f)) cos theta_i over
+// the cell (r, c) of wi for wo at (theta_o, phi_o): cells relative to phi_o, a
+// cell_samples^2 midpoint rule uniform in 1 - cos theta_i and phi_i.
+void add_cell_weights(const Brdf& f, double to, double po, const SamplerGeometry& geo, int T, int P, int S,
+                      std::vector<double>& cell) {
+  const Vec3 wo(std::sin(to) * std::cos(po), std::sin(to) * std::sin(po), std::cos(to));
+  for (int r = 0; r < T; ++r) {
+    const double oa = geo.row_omc[r], ob = geo.row_omc[r + 1];
+    for (int c = 0; c < P; ++c) {
+      double sum = 0;
+      for (int i = 0; i < S; ++i) {
+        const double omc = oa + (ob - oa) * (i + 0.5) / S, ct = 1.0 - omc;
+        const double st = std::sqrt(std::max(0.0, omc * (2.0 - omc)));
+        for (int j = 0; j < S; ++j) {
+          const double phi = po + (c + (j + 0.5) / S) * kTwoPi / P;
+          const Vec3 wi(st * std::cos(phi), st * std::sin(phi), ct);
+          const double y = luminance(f.eval(wi, wo));
+          if (std::isfinite(y) && y > 0) sum += y * ct;
+        }
+      }
+      // Solid angle of the cell: (ob - oa) 2 pi / P.
+      cell[static_cast<size_t>(r) * P + c] += sum / (S * S) * (ob - oa) * kTwoPi / P;
+    }
+  }
+}
+
+// View azimuths averaged into the single table of a BRDF that does not say
+// it is isotropic when view_phi_bins = 1.
+constexpr int kIsoAzimuths = 8;
+
 void require(bool ok, const char* field, const std::string& rule, double value) {
   if (!ok) {
     throw OptionError(field, std::string("sampler option ") + field + ": " + rule + ", found " +
@@ -238,8 +339,10 @@ void SamplerOptions::validate() const {
   require(phi_bins >= 2 && phi_bins <= 1024, "phi_bins", "an integer in [2, 1024]", phi_bins);
   require(view_phi_bins >= 0 && view_phi_bins <= 256, "view_phi_bins", "an integer in [0, 256]",
           view_phi_bins);
-  require(std::isfinite(cosine_fraction) && cosine_fraction > 0 && cosine_fraction < 1,
-          "cosine_fraction", "a number in (0, 1)", cosine_fraction);
+  // Used as float32 (as the GLSL export holds it), which must still be in (0, 1).
+  require(std::isfinite(cosine_fraction) && static_cast<float>(cosine_fraction) > 0 &&
+              static_cast<float>(cosine_fraction) < 1,
+          "cosine_fraction", "a number in (0, 1) also as float32", cosine_fraction);
   require(cell_samples >= 1 && cell_samples <= 16, "cell_samples", "an integer in [1, 16]", cell_samples);
   if (method != "auto" && method != "tabulated") {
     throw OptionError("method", "sampler option method: \"auto\" or \"tabulated\", found \"" + method + "\"");
@@ -261,38 +364,29 @@ std::shared_ptr<const BrdfSampler> make_sampler(const Brdf& f, const SamplerOpti
   t.view_phi_bins = o.view_phi_bins > 0 ? o.view_phi_bins : (f.isotropic() ? 1 : 16);
   t.theta_bins = o.theta_bins;
   t.phi_bins = o.phi_bins;
-  t.cosine_fraction = o.cosine_fraction;
+  // float32, as the GLSL export holds it (u1 is compared with it).
+  t.cosine_fraction = static_cast<float>(o.cosine_fraction);
   const int V = t.view_bins * t.view_phi_bins, T = t.theta_bins, P = t.phi_bins, S = o.cell_samples;
   t.row_cdf.assign(static_cast<size_t>(V) * (T + 1), 0.0f);
   t.col_cdf.assign(static_cast<size_t>(V) * T * (P + 1), 0.0f);
   t.empty.assign(V, 1);
   std::vector<double> cell(static_cast<size_t>(T) * P), row(T);
+  const SamplerGeometry geo = sampler_geometry(t);
   for (int vt = 0; vt < t.view_bins; ++vt) {
     for (int vp = 0; vp < t.view_phi_bins; ++vp) {
       const int v = vt * t.view_phi_bins + vp;
+      // The bin centre: theta_o = (vt + 1/2) pi / (2 view_bins), phi_o = 2 pi vp / view_phi_bins.
       const double to = (vt + 0.5) * kHalfPi / t.view_bins, po = vp * kTwoPi / t.view_phi_bins;
-      const Vec3 wo(std::sin(to) * std::cos(po), std::sin(to) * std::sin(po), std::cos(to));
+      // A BRDF that does not say it is isotropic, given one azimuth bin: the
+      // mean of f cos over kIsoAzimuths view azimuths (the best single table
+      // of, e.g., a factorization of an isotropic BRDF).
+      const int na = (t.view_phi_bins == 1 && !f.isotropic()) ? kIsoAzimuths : 1;
+      std::fill(cell.begin(), cell.end(), 0.0);
+      for (int k = 0; k < na; ++k) add_cell_weights(f, to, po + k * kTwoPi / na, geo, T, P, S, cell);
       double total = 0;
       for (int r = 0; r < T; ++r) {
-        const double ca = std::cos(r * kHalfPi / T), cb = std::cos((r + 1) * kHalfPi / T);
         row[r] = 0;
-        for (int c = 0; c < P; ++c) {
-          double sum = 0;
-          for (int i = 0; i < S; ++i) {
-            const double ct = ca + (cb - ca) * (i + 0.5) / S;
-            const double st = std::sqrt(std::max(0.0, 1.0 - ct * ct));
-            for (int j = 0; j < S; ++j) {
-              const double phi = po + (c + (j + 0.5) / S) * kTwoPi / P;
-              const Vec3 wi(st * std::cos(phi), st * std::sin(phi), ct);
-              const double y = luminance(f.eval(wi, wo));
-              if (std::isfinite(y) && y > 0) sum += y * ct;
-            }
-          }
-          // Integral of f cos over the cell (solid angle (ca - cb) 2 pi / P).
-          const double w = sum / (S * S) * (ca - cb) * kTwoPi / P;
-          cell[static_cast<size_t>(r) * P + c] = w;
-          row[r] += w;
-        }
+        for (int c = 0; c < P; ++c) row[r] += cell[static_cast<size_t>(r) * P + c];
         total += row[r];
       }
       if (!(total > 0) || !std::isfinite(total)) continue;
@@ -315,6 +409,18 @@ std::shared_ptr<const BrdfSampler> make_sampler(const Brdf& f, const SamplerOpti
     }
   }
   return std::make_shared<TabulatedSampler>(std::move(t));
+}
+
+SamplerGeometry sampler_geometry(const SamplerTable& t) {
+  SamplerGeometry g;
+  auto f32 = [](double v) { return static_cast<double>(static_cast<float>(v)); };
+  for (int k = 0; k < t.view_bins; ++k) g.view_cos.push_back(f32(std::cos((k + 0.5) * kHalfPi / t.view_bins)));
+  for (int r = 0; r <= t.theta_bins; ++r) {
+    const double s = std::sin(r * kHalfPi / t.theta_bins / 2);
+    g.row_omc.push_back(f32(2 * s * s));  // 1 - cos
+  }
+  g.row_omc.back() = 1.0;  // the horizon
+  return g;
 }
 
 std::shared_ptr<const BrdfSampler> tabulated_sampler(SamplerTable t) {

@@ -37,7 +37,7 @@ class BrdfSampler {
 struct SamplerOptions {
   // Bins of the view direction's polar angle theta_o over [0, pi/2), uniform
   // in theta_o; the table between two bin centres is a mixture of both
-  // (weights linear in theta_o). 1..256.
+  // (weights linear in cos theta_o). 1..256.
   int view_bins = 16;
   // Cells of wi: theta_bins uniform in theta_i over [0, pi/2] times
   // phi_bins uniform in the azimuth of wi relative to that of wo over
@@ -46,9 +46,12 @@ struct SamplerOptions {
   int phi_bins = 64;
   // Bins of the view azimuth phi_o over [0, 2 pi) (nearest bin). 0 = 1 for a
   // BRDF that says it is isotropic (Brdf::isotropic()), else 16. 0..256.
+  // 1 for a BRDF that does not say it is isotropic (a factorization of an
+  // isotropic BRDF): the table is the mean of f cos over 8 view azimuths.
   int view_phi_bins = 0;
   // Probability of drawing wi from the cosine lobe cos(theta_i) / pi instead
-  // of the table: keeps the pdf positive over the whole hemisphere. (0, 1).
+  // of the table: keeps the pdf positive over the whole hemisphere. (0, 1);
+  // used rounded to float32 (as the GLSL export holds it).
   double cosine_fraction = 0.1;
   // f cos theta_i is integrated over each cell by a cell_samples^2 midpoint
   // rule (uniform in cos theta_i and phi_i). 1..16.
@@ -79,6 +82,17 @@ struct SamplerTable {
   std::vector<float> row_cdf, col_cdf;
   std::vector<unsigned char> empty;  // per view bin: 1 = no table (cosine only)
 };
+// The values the tabulated sampler compares directions with, rounded to
+// float32 (the GLSL export holds the same values as constants, so CPU and GPU
+// bin a direction alike): view_cos[k] = cos of the centre of theta_o bin k,
+// (k + 1/2) pi / (2 view_bins), decreasing; row_omc[r] = 1 - cos of the
+// edge r pi / (2 theta_bins) of the theta_i rows (theta_bins + 1 values, 0
+// first, 1 last; 1 - cos rather than cos keeps the rows near the normal
+// precise in float32). Row r holds row_omc[r] <= 1 - cos theta_i < row_omc[r + 1].
+struct SamplerGeometry {
+  std::vector<double> view_cos, row_omc;
+};
+SamplerGeometry sampler_geometry(const SamplerTable& t);
 // The table of a tabulated sampler; nullptr for other methods.
 const SamplerTable* sampler_table(const BrdfSampler& s);
 

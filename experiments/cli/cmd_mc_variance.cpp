@@ -35,7 +35,8 @@ void add_cmd_mc_variance(CLI::App& app) {
                                  "Monte Carlo render of the SH-lit sphere per sampler: variance table (and noise CSV)");
   struct Args {
     std::string brdf, approx, env, noise_csv;
-    int spp = 64, size = 48, order = 8;
+    bool mis = false;
+    int spp = 64, size = 48, order = 8, view_phi_bins = 0;
     double eps = 1e-3;
     unsigned long long seed = 1;
   };
@@ -50,11 +51,21 @@ void add_cmd_mc_variance(CLI::App& app) {
   cmd->add_option("--spp", a->spp, "samples per pixel of the variance column")->capture_default_str();
   cmd->add_option("--size", a->size, "pixels per edge")->capture_default_str();
   cmd->add_option("--seed", a->seed, "seed")->capture_default_str();
+  cmd->add_option("--view-phi-bins", a->view_phi_bins,
+                  "view azimuth bins of the tabulated sampler (0: 1 for an isotropic BRDF, else 16; "
+                  "1 for a factorization of an isotropic BRDF, as run does)")
+      ->capture_default_str();
   cmd->add_option("--noise-csv", a->noise_csv, "write integrand,sampler,spp,rmse rows here");
+  cmd->add_flag("--mis", a->mis,
+                "also each sampler combined with sampling the light (one-sample MIS, balance heuristic, "
+                "half the samples each): rows <sampler>+light, vs_cosine against cosine+light");
   cmd->callback([a] {
     if (a->spp < 2) throw std::invalid_argument("mc-variance: --spp: expected >= 2, found " + std::to_string(a->spp));
     if (a->size < 8 || a->size > 1024)
       throw std::invalid_argument("mc-variance: --size: expected 8..1024, found " + std::to_string(a->size));
+    if (a->view_phi_bins < 0 || a->view_phi_bins > 256)
+      throw std::invalid_argument("mc-variance: --view-phi-bins: expected 0..256, found " +
+                                  std::to_string(a->view_phi_bins));
     if (a->order < 0 || a->order > 60)
       throw std::invalid_argument("mc-variance: --order: expected 0..60, found " + std::to_string(a->order));
     SceneSettings scene;
@@ -80,26 +91,37 @@ void add_cmd_mc_variance(CLI::App& app) {
       if (!noise) throw std::runtime_error(a->noise_csv + ": cannot write the noise CSV");
       noise << "integrand,sampler,spp,rmse\n";
     }
-    std::printf("%-9s %-10s %8s %12s %10s %12s\n", "integrand", "sampler", "spp", "variance", "vs_cosine",
+    std::unique_ptr<const LightSampler> light;
+    if (a->mis) light = std::make_unique<const LightSampler>(*scene.lighting);
+    std::printf("%-9s %-16s %8s %12s %10s %12s\n", "integrand", "sampler", "spp", "variance", "vs_cosine",
                 "image_rmse");
     for (const Integrand& in : integrands) {
       const SphereRender det = render_sphere(*in.f, scene);
       std::vector<std::pair<std::string, std::shared_ptr<const BrdfSampler>>> samplers{{"cosine", cosine_sampler()}};
       SamplerOptions tab;
       tab.method = "tabulated";
+      tab.view_phi_bins = a->view_phi_bins;
       samplers.push_back({"tabulated", make_sampler(*in.f, tab)});
-      if (dynamic_cast<const CookTorrance*>(in.f.get())) samplers.push_back({"model", make_sampler(*in.f)});
-      double cos_var = 0;
-      for (const auto& [name, s] : samplers) {
-        const McRender r = render_sphere_mc(*in.f, *s, scene, a->spp, a->seed);
-        const double v = r.pixel_variance();
-        if (name == "cosine") cos_var = v;
-        std::printf("%-9s %-10s %8d %12s %10s %12s\n", in.name.c_str(), name.c_str(), a->spp, num(v).c_str(),
-                    cos_var > 0 ? num(v / cos_var).c_str() : "-", num(image_rmse(det, r.image)).c_str());
-        if (noise.is_open())
-          for (int spp = 4; spp <= 4 * a->spp; spp *= 4)
-            noise << in.name << "," << name << "," << spp << ","
-                  << image_rmse(det, render_sphere_mc(*in.f, *s, scene, spp, a->seed + 1).image) << "\n";
+      // The analytic model's own sampler (Beckmann) for the original, and for
+      // the approximation of it too (the same integrand compared with three samplers).
+      if (dynamic_cast<const CookTorrance*>(integrands[0].f.get()))
+        samplers.push_back({"model", make_sampler(*integrands[0].f)});
+      for (int pass = 0; pass < (light ? 2 : 1); ++pass) {
+        const LightSampler* ls = pass == 1 ? light.get() : nullptr;
+        const std::string suffix = ls ? "+light" : "";
+        double cos_var = 0;
+        for (const auto& [name, s] : samplers) {
+          const McRender r = render_sphere_mc(*in.f, *s, scene, a->spp, a->seed, ls);
+          const double v = r.pixel_variance();
+          if (name == "cosine") cos_var = v;
+          std::printf("%-9s %-16s %8d %12s %10s %12s\n", in.name.c_str(), (name + suffix).c_str(), a->spp,
+                      num(v).c_str(), cos_var > 0 ? num(v / cos_var).c_str() : "-",
+                      num(image_rmse(det, r.image)).c_str());
+          if (noise.is_open())
+            for (int spp = 4; spp <= 4 * a->spp; spp *= 4)
+              noise << in.name << "," << name << suffix << "," << spp << ","
+                    << image_rmse(det, render_sphere_mc(*in.f, *s, scene, spp, a->seed + 1, ls).image) << "\n";
+        }
       }
     }
   });

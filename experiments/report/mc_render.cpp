@@ -1,6 +1,7 @@
 // Monte Carlo render of the SH-lit sphere (see mc_render.h).
 #include "experiments/report/mc_render.h"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -25,6 +26,74 @@ struct Rng {
 
 }  // namespace
 
+LightSampler::LightSampler(const ShLighting& light, int rows, int cols, double uniform)
+    : rows_(rows), cols_(cols), uniform_(uniform) {
+  if (rows < 1 || cols < 1 || rows > 4096 || cols > 4096)
+    throw std::invalid_argument("light sampler: rows and cols: expected 1..4096, found " + std::to_string(rows) +
+                                " x " + std::to_string(cols));
+  if (!(uniform > 0 && uniform <= 1))
+    throw std::invalid_argument("light sampler: uniform: expected a number in (0, 1], found " +
+                                std::to_string(uniform));
+  const size_t n = static_cast<size_t>(rows) * cols;
+  std::vector<double> w(n);
+  double total = 0;
+  for (int r = 0; r < rows; ++r) {
+    const double z = -1.0 + (r + 0.5) * 2.0 / rows, sz = std::sqrt(std::max(0.0, 1.0 - z * z));
+    for (int c = 0; c < cols; ++c) {
+      const double ph = (c + 0.5) * 2.0 * M_PI / cols;
+      const Rgb L = light.radiance(Vec3(sz * std::cos(ph), sz * std::sin(ph), z));
+      const double y = std::abs(0.2126 * L[0] + 0.7152 * L[1] + 0.0722 * L[2]);
+      w[static_cast<size_t>(r) * cols + c] = std::isfinite(y) ? y : 0.0;
+      total += w[static_cast<size_t>(r) * cols + c];
+    }
+  }
+  if (!(total > 0)) uniform_ = 1.0;  // a black sky: uniform sampling only
+  // Probability of each cell (table and uniform parts mixed), then the CDFs.
+  const double cell_area = 4.0 * M_PI / static_cast<double>(n);
+  cell_pdf_.resize(n);
+  row_cdf_.assign(rows + 1, 0.0);
+  col_cdf_.assign(static_cast<size_t>(rows) * (cols + 1), 0.0);
+  for (int r = 0; r < rows; ++r) {
+    double row = 0;
+    for (int c = 0; c < cols; ++c) {
+      const size_t k = static_cast<size_t>(r) * cols + c;
+      const double p = (1.0 - uniform_) * (total > 0 ? w[k] / total : 0.0) + uniform_ / static_cast<double>(n);
+      cell_pdf_[k] = p / cell_area;
+      col_cdf_[static_cast<size_t>(r) * (cols + 1) + c + 1] = (row += p);
+    }
+    for (int c = 1; c <= cols; ++c) col_cdf_[static_cast<size_t>(r) * (cols + 1) + c] /= row;
+    row_cdf_[r + 1] = row_cdf_[r] + row;
+  }
+  for (double& v : row_cdf_) v /= row_cdf_[rows];
+}
+
+namespace {
+// Index i in [0, n) with cdf[i] <= u < cdf[i + 1], skipping empty steps.
+int find_step(const double* cdf, int n, double u) {
+  const int i = static_cast<int>(std::upper_bound(cdf, cdf + n + 1, u) - cdf) - 1;
+  return std::min(std::max(i, 0), n - 1);
+}
+}  // namespace
+
+DirectionSample LightSampler::sample(double u1, double u2) const {
+  const int r = find_step(row_cdf_.data(), rows_, u1);
+  const double v1 = std::min(1.0, std::max(0.0, (u1 - row_cdf_[r]) / (row_cdf_[r + 1] - row_cdf_[r])));
+  const double* cc = &col_cdf_[static_cast<size_t>(r) * (cols_ + 1)];
+  const int c = find_step(cc, cols_, u2);
+  const double v2 = std::min(1.0, std::max(0.0, (u2 - cc[c]) / (cc[c + 1] - cc[c])));
+  const double z = std::min(1.0, std::max(-1.0, -1.0 + (r + v1) * 2.0 / rows_));
+  const double sz = std::sqrt(std::max(0.0, 1.0 - z * z)), ph = (c + v2) * 2.0 * M_PI / cols_;
+  return {Vec3(sz * std::cos(ph), sz * std::sin(ph), z), cell_pdf_[static_cast<size_t>(r) * cols_ + c]};
+}
+
+double LightSampler::pdf(const Vec3& w) const {
+  const int r = std::min(rows_ - 1, std::max(0, static_cast<int>((w.z() + 1.0) * 0.5 * rows_)));
+  double ph = std::atan2(w.y(), w.x());
+  if (ph < 0) ph += 2.0 * M_PI;
+  const int c = std::min(cols_ - 1, std::max(0, static_cast<int>(ph / (2.0 * M_PI) * cols_)));
+  return cell_pdf_[static_cast<size_t>(r) * cols_ + c];
+}
+
 double McRender::pixel_variance() const {
   double s = 0;
   size_t n = 0;
@@ -37,7 +106,7 @@ double McRender::pixel_variance() const {
 }
 
 McRender render_sphere_mc(const Brdf& f, const BrdfSampler& sampler, const SceneSettings& scene, int spp,
-                          uint64_t seed) {
+                          uint64_t seed, const LightSampler* light_sampler) {
   if (!scene.lighting)
     throw std::invalid_argument("Monte Carlo render: the scene has no integrable light: set [scene] environment or "
                                 "lighting_order (a point light is never hit by a sampled direction)");
@@ -70,7 +139,24 @@ McRender render_sphere_mc(const Brdf& f, const BrdfSampler& sampler, const Scene
       double s1 = 0, s2 = 0;  // mean-over-RGB estimate: sum and sum of squares
       for (int j = 0; j < spp; ++j) {
         const double u1 = rng.uniform(), u2 = rng.uniform();
-        const DirectionSample d = sampler.sample(wo, u1, u2);
+        DirectionSample d;
+        if (!light_sampler) {
+          d = sampler.sample(wo, u1, u2);
+        } else {
+          // One-sample MIS: the choice by a third number, the mixture's pdf.
+          const bool from_light = rng.uniform() < 0.5;
+          if (from_light) {
+            const DirectionSample l = light_sampler->sample(u1, u2);
+            d.wi = Vec3(l.wi.dot(t), l.wi.dot(b), l.wi.dot(nrm));
+            d.pdf = 0.5 * l.pdf + 0.5 * sampler.pdf(d.wi, wo);
+          } else {
+            d = sampler.sample(wo, u1, u2);
+            if (d.pdf > 0.0) {
+              const Vec3 w = d.wi.x() * t + d.wi.y() * b + d.wi.z() * nrm;
+              d.pdf = 0.5 * d.pdf + 0.5 * light_sampler->pdf(w);
+            }
+          }
+        }
         Rgb e = Rgb::Zero();
         if (d.pdf > 0.0 && d.wi.z() > 0.0) {
           Rgb fv = f.eval(d.wi, wo);
@@ -82,7 +168,7 @@ McRender render_sphere_mc(const Brdf& f, const BrdfSampler& sampler, const Scene
           e = fv * light.radiance(wi_world) * (d.wi.z() / d.pdf);
         } else if (!(d.pdf > 0.0)) {
           ++r.no_sample;
-        }
+        }  // a light sample below the horizon: estimate 0 (it is part of the mixture)
         sum += e;
         const double m = e.mean();
         s1 += m;

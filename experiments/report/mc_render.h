@@ -15,6 +15,7 @@
 #include "brdfs/brdf.h"
 #include "experiments/plan/plan.h"
 #include "experiments/report/render.h"
+#include "factor/lighting.h"
 #include "factor/sampling.h"
 
 namespace bf {
@@ -31,12 +32,39 @@ struct McRender {
   double pixel_variance() const;
 };
 
+// Importance sampling of the scene's light for multiple importance sampling:
+// a table of |Y(L)| (Y the Rec. 709 luminance of the SH radiance, in world
+// directions) at the centres of rows x cols cells of equal solid angle (rows
+// uniform in z over [-1, 1], cols uniform in the azimuth), plus `uniform`
+// of the uniform sphere density so that the pdf is positive everywhere; wi
+// uniform in solid angle inside a cell. Exact pdf of what it draws.
+class LightSampler {
+ public:
+  // rows, cols >= 1; 0 < uniform <= 1. Throws std::invalid_argument naming the field.
+  explicit LightSampler(const ShLighting& light, int rows = 64, int cols = 128, double uniform = 0.05);
+  DirectionSample sample(double u1, double u2) const;  // world direction, pdf per solid angle
+  double pdf(const Vec3& w) const;                     // w world, unit
+ private:
+  int rows_, cols_;
+  double uniform_;
+  std::vector<double> cell_pdf_;    // per solid angle, for the table part
+  std::vector<double> row_cdf_;     // rows + 1
+  std::vector<double> col_cdf_;     // rows * (cols + 1)
+};
+
 // scene.lighting must be set (SH-lit scene), else std::invalid_argument
 // naming `[scene] environment or lighting_order`. spp >= 2. Pixels are
 // independent streams of a 64-bit generator seeded by (seed, pixel), so the
 // render is deterministic for a seed. Non-finite values of f count as 0 and in
 // image.nonfinite.
+//
+// With `light`: one-sample multiple importance sampling (the balance
+// heuristic): each sample draws wi from the BRDF sampler or from the light
+// with probability 1/2 each, and the estimate is
+//   f cos L / (p_brdf(wi) / 2 + p_light(wi) / 2),
+// which stays unbiased where either pdf is positive and removes the variance
+// of a light (a sun) the BRDF sampler cannot find.
 McRender render_sphere_mc(const Brdf& f, const BrdfSampler& sampler, const SceneSettings& scene, int spp,
-                          uint64_t seed);
+                          uint64_t seed, const LightSampler* light = nullptr);
 
 }  // namespace bf

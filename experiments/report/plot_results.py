@@ -14,6 +14,9 @@ Writes into --out (default: plots/ beside the CSV), one file per figure:
                     (left) and against seconds (right), Pareto fronts; for
                     --metric and for cos_rmse (the fair metric when SH methods,
                     which represent f cos, take part)
+  noise_vs_spp      runs with `sampler = true`: Monte Carlo image RMSE against
+                    samples per pixel, cosine and the run's own sampler (the
+                    "noise" rows of "sampling" in runs/<run_id>/run.json)
 
 What the figures promise:
   - one series = one method label with one requested parameterization
@@ -424,6 +427,51 @@ def input_hash(csv_path, args):
     return h.hexdigest()
 
 
+def noise_lines(csv_path, rows):
+    """(legend, [(spp, rmse)]) per run and sampler from the "noise" rows of the
+    sampler entry in runs/<run_id>/run.json beside the CSV (`sampler = true`)."""
+    base = os.path.dirname(os.path.abspath(csv_path))
+    lines = OrderedDict()
+    for r in rows:
+        path = os.path.join(base, "runs", r.get("run_id", ""), "run.json")
+        try:
+            with open(path) as f:
+                noise = json.load(f).get("sampler", {}).get("noise", [])
+        except (OSError, ValueError, AttributeError):
+            continue
+        for n in noise if isinstance(noise, list) else []:
+            try:
+                spp, rmse = int(n["spp"]), float(n["rmse"])
+            except (KeyError, TypeError, ValueError):
+                continue
+            if spp > 0 and math.isfinite(rmse) and rmse > 0:
+                key = "%s %s / %s" % (r.get("brdf", ""), label_of(r), n.get("sampler", ""))
+                lines.setdefault(key, []).append((spp, rmse))
+    return [(k, sorted(v)) for k, v in lines.items()]
+
+
+def plot_noise(plt, lines, out_dir, formats):
+    """Monte Carlo noise against samples per pixel, one line per run and
+    sampler, with a dotted 1/sqrt(N) guide through each line's first point."""
+    if not lines:
+        return []
+    fig, ax = plt.subplots(figsize=(6.4, 4.4))
+    for name, pts in lines:
+        x, y = [p[0] for p in pts], [p[1] for p in pts]
+        (h,) = ax.plot(x, y, marker="o", label=name)
+        ax.plot(x, [y[0] * math.sqrt(x[0] / v) for v in x], ls=":", color=h.get_color(), lw=0.8)
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("samples per pixel")
+    ax.set_ylabel("image RMSE vs deterministic render")
+    ax.set_title("Monte Carlo noise of the sampled runs (dotted: 1/sqrt(N))")
+    for t in ax.legend(fontsize=7).get_texts():
+        plain(t)
+    written = save(fig, out_dir, "noise_vs_spp", formats)
+    plt.close(fig)
+    return written
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("csv")
@@ -481,6 +529,7 @@ def main():
                                 [key], False, log_x=False)
     for metric in OrderedDict.fromkeys([a.metric, "cos_rmse"]):
         written += plot_by_brdf(plt, all_rows, metric, out_dir, formats, axis_keys)
+    written += plot_noise(plt, noise_lines(a.csv, all_rows), out_dir, formats)
 
     tmp = stamp + ".tmp"
     with open(tmp, "w") as f:

@@ -239,7 +239,8 @@ RunEntry execute_run(const Plan& plan, const PlannedRun& pr, const SampleSet& sa
   }
 
   if (plan.experiment.export_factors) kind.export_files(c, out);
-  if (m.sampler) run_sampling(*out.result, plan.experiment.export_factors, run_dir, row, rec);
+  if (m.sampler)
+    run_sampling(*out.result, isotropy.isotropic, plan.scene, plan.experiment.export_factors, run_dir, row, rec);
   if (plan.experiment.render || plan.scene.shade) {
     const auto original = renders.get(plan, pr.brdf);
     const SphereRender approx = render_sphere(*out.result, plan.scene);

@@ -7,6 +7,7 @@
 #include "brdfs/catalogue.h"
 #include "brdfs/models.h"
 #include "experiments/report/mc_render.h"
+#include "experiments_helpers.h"
 #include "factor/lighting.h"
 
 using namespace bf;
@@ -118,4 +119,65 @@ TEST_CASE("mc render: a point-lit scene or too few samples is refused with the k
   SceneSettings point;
   CHECK_THROWS_WITH(render_sphere_mc(*f, *cosine_sampler(), point, 16, 1), Catch::Contains("lighting_order"));
   CHECK_THROWS_WITH(render_sphere_mc(*f, *cosine_sampler(), lit_scene(8, 2), 1, 1), Catch::Contains("spp"));
+}
+
+TEST_CASE("mc render: the light sampler's pdf integrates to 1 and is the density it draws") {
+  const ShLighting light = directional_lighting(Vec3(0.3, 0.2, 0.9).normalized(), Rgb(1.0, 0.9, 0.8), 12);
+  const LightSampler ls(light, 16, 32);
+  // Integral over the sphere by a fine midpoint rule (uniform in z and phi).
+  double sum = 0;
+  const int nz = 256, np = 512;
+  for (int i = 0; i < nz; ++i)
+    for (int j = 0; j < np; ++j) {
+      const double z = -1 + (i + 0.5) * 2.0 / nz, s = std::sqrt(1 - z * z), ph = (j + 0.5) * 2 * M_PI / np;
+      sum += ls.pdf(Vec3(s * std::cos(ph), s * std::sin(ph), z));
+    }
+  CHECK(std::abs(sum * 4 * M_PI / (nz * np) - 1.0) < 1e-9);
+  // A sample's pdf is pdf() at its direction; the peak cell holds the light.
+  double best = 0;
+  Vec3 at = Vec3::Zero();
+  for (double u1 : {0.05, 0.3, 0.5, 0.77, 0.99})
+    for (double u2 : {0.1, 0.6, 0.95}) {
+      const DirectionSample d = ls.sample(u1, u2);
+      CHECK(std::abs(d.wi.norm() - 1) < 1e-12);
+      CHECK(d.pdf == Approx(ls.pdf(d.wi)).epsilon(1e-12));
+      if (d.pdf > best) best = d.pdf, at = d.wi;
+    }
+  CHECK(at.dot(Vec3(0.3, 0.2, 0.9).normalized()) > 0.9);
+  CHECK_THROWS_WITH(LightSampler(light, 0, 8), Catch::Contains("rows and cols"));
+  CHECK_THROWS_WITH(LightSampler(light, 8, 8, 0.0), Catch::Contains("uniform"));
+}
+
+TEST_CASE("mc render: with light sampling the render stays unbiased and a narrow light's variance falls") {
+  const auto f = Catalogue::global().make("blinn-phong:n=5");
+  const SceneSettings scene = lit_scene(12, 16);
+  const LightSampler ls(*scene.lighting);
+  const SphereRender det = render_sphere(*f, scene);
+  const McRender mis = render_sphere_mc(*f, *cosine_sampler(), scene, 256, 5, &ls);
+  const McRender plain = render_sphere_mc(*f, *cosine_sampler(), scene, 256, 5);
+  INFO("cosine " << plain.pixel_variance() << " cosine+light " << mis.pixel_variance());
+  const double r = mse_mean_rgb(det, mis.image) / mis.pixel_variance();
+  CHECK(r > 0.6);
+  CHECK(r < 1.6);
+  CHECK(mis.pixel_variance() < 0.5 * plain.pixel_variance());
+}
+
+TEST_CASE("mc render: mc-variance prints one row per sampler and with --mis one more per sampler") {
+  auto rows = [](const std::string& out) {
+    std::vector<std::string> names;
+    std::istringstream in(out);
+    std::string integrand, sampler, rest;
+    while (in >> integrand >> sampler && std::getline(in, rest))
+      if (integrand != "integrand") names.push_back(integrand + " " + sampler);
+    return names;
+  };
+  std::string out;
+  REQUIRE(bf_test::run_cli("mc-variance --brdf cook-torrance:m=0.2 --order 2 --spp 4 --size 8", &out) == 0);
+  CHECK(rows(out) == std::vector<std::string>{"original cosine", "original tabulated", "original model"});
+  REQUIRE(bf_test::run_cli("mc-variance --brdf cook-torrance:m=0.2 --order 2 --spp 4 --size 8 --mis", &out) == 0);
+  CHECK(rows(out) == std::vector<std::string>{"original cosine", "original tabulated", "original model",
+                                              "original cosine+light", "original tabulated+light",
+                                              "original model+light"});
+  CHECK(bf_test::run_cli("mc-variance --brdf lambert --order 2 --view-phi-bins 300", &out) == 2);
+  CHECK_THAT(out, Catch::Contains("--view-phi-bins") && Catch::Contains("300"));
 }

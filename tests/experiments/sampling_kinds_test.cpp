@@ -5,6 +5,7 @@
 // three views), on bluepaint, Cook-Torrance m = 0.2 and the Cornell paint
 // krylon-blue.
 #include <cmath>
+#include <map>
 
 #include "brdfs/catalogue.h"
 #include "experiments/methods/method_kind.h"
@@ -122,6 +123,7 @@ order = 2
     const BrdfPtr f = Catalogue::global().make((run / "factors.json").string());
     SamplerOptions so;
     so.method = "tabulated";
+    so.view_phi_bins = entry.at("view_phi_bins").get<int>();
     const auto want = make_sampler(*f, so);
     const auto got = tabulated_sampler(
         sampling_table_from(read_exr((run / "sampling.exr").string()), entry, "sampling.exr"));
@@ -136,6 +138,104 @@ order = 2
     // run.json's "sampling" stays the sample set's description.
     CHECK(rec.at("sampling") == "grid 6^4");
   }
+}
+
+// A factorization never says it is isotropic (its terms read absolute
+// azimuths), but one of an isotropic BRDF approximates an isotropic
+// function: its table then has one view azimuth bin (the mean over view
+// azimuths), 1/16 of the storage; of an anisotropic BRDF, 16 bins.
+// (chi2 of such a table: tests/factor/sampling_test.cpp.)
+namespace {
+void check_view_phi_bins(const std::string& brdf, bool iso) {
+  INFO(brdf);
+  ScratchDir tmp;
+  const std::string cfg = write_text(tmp / "cfg.toml", std::string(R"([experiment]
+name = "t"
+plots = false
+render = false
+
+[[brdf]]
+)") + brdf + R"(
+
+[sampling]
+kind = "grid"
+resolution = 6
+
+[[method]]
+kind = "mccool"
+texture_size = 8
+sampler = true
+)");
+  const RunSummary s = run_quiet(cfg, tmp / "out");
+  REQUIRE(s.failed == 0);
+  const auto rows = read_results_csv(tmp / "out/results.csv");
+  REQUIRE(rows.size() == 1);
+  CHECK(rows[0].at("isotropic") == (iso ? "true" : "false"));
+  const fs::path run = fs::path(tmp / "out/runs") / rows[0].at("run_id");
+  const nlohmann::json rec = nlohmann::json::parse(slurp((run / "run.json").string()));
+  CHECK(rec.at("sampler").at("view_phi_bins").get<int>() == (iso ? 1 : 16));
+  CHECK(rows[0].at("sampler_storage") == std::to_string((iso ? 1 : 16) * 16 * (33 + 32 * 65)));
+}
+}  // namespace
+
+TEST_CASE("sampling: the sampler of a fit has one view azimuth bin when the fitted BRDF is isotropic") {
+  check_view_phi_bins("preset = \"bluepaint\"", true);
+}
+
+TEST_CASE("sampling: the sampler of a fit of an anisotropic BRDF keeps 16 view azimuth bins", "[slow]") {
+  check_view_phi_bins("model = \"ward\"\nax = 0.1\nay = 0.3", false);
+}
+
+// A run with sampling on records its Monte Carlo noise against samples
+// (cosine and its own sampler at 4, 16, 64 spp) in run.json; with plots,
+// report.html shows it (plot_results.py: noise_vs_spp).
+namespace {
+void check_noise_rows(bool plots) {
+  ScratchDir tmp;
+  const std::string cfg = write_text(tmp / "cfg.toml", R"([experiment]
+name = "t"
+render = false
+
+[[brdf]]
+preset = "bluepaint"
+
+[sampling]
+kind = "grid"
+resolution = 6
+
+[[method]]
+kind = "sh-k"
+order = 2
+sampler = true
+)");
+  const RunSummary s = run_quiet(cfg, tmp / "out", {}, plots);
+  REQUIRE(s.failed == 0);
+  const auto rows = read_results_csv(tmp / "out/results.csv");
+  REQUIRE(rows.size() == 1);
+  const nlohmann::json rec =
+      nlohmann::json::parse(slurp((fs::path(tmp / "out/runs") / rows[0].at("run_id") / "run.json").string()));
+  const nlohmann::json& noise = rec.at("sampler").at("noise");
+  REQUIRE(noise.size() == 6);
+  std::map<std::string, std::vector<double>> rmse;
+  for (const auto& n : noise) rmse[n.at("sampler").get<std::string>()].push_back(n.at("rmse").get<double>());
+  for (const auto& [sampler, r] : rmse) {
+    INFO(sampler);
+    REQUIRE(r.size() == 3);
+    for (double v : r) CHECK((std::isfinite(v) && v > 0));
+    CHECK(r[2] < r[0]);  // 16x the samples: less noise
+  }
+  if (!plots) return;
+  CHECK(fs::exists(tmp / "out/plots/noise_vs_spp.png"));
+  CHECK(slurp(tmp / "out/report.html").find("plots/noise_vs_spp.png") != std::string::npos);
+}
+}  // namespace
+
+TEST_CASE("sampling: a run with sampling on records its Monte Carlo noise against samples") {
+  check_noise_rows(false);
+}
+
+TEST_CASE("sampling: report.html shows the noise against samples of a run with sampling on", "[slow]") {
+  check_noise_rows(true);
 }
 
 TEST_CASE("sampling: sample-dirs prints n samples and names bad arguments") {
