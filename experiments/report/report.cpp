@@ -41,7 +41,9 @@ details.notes summary{cursor:pointer;color:#555}details.notes{max-width:40em;whi
 .texbar .ramp{display:block;height:10px;background:linear-gradient(to right,#000,rgb(26,38,217),rgb(230,26,51),rgb(255,217,26),#fff)}
 .texbar span:not(.ramp){display:inline-block;width:33.3%;text-align:center}.texbar span:nth-child(2){text-align:left}
 .texbar span:nth-child(4){text-align:right}
-.vrow{display:flex;flex-wrap:wrap;gap:1em;align-items:flex-start}.vrow figure{margin:0}
+.vrow{display:flex;flex-wrap:wrap;gap:1em;align-items:flex-start}.vrow figure{margin:0}.vrow figcaption{max-width:420px}
+#viewer canvas.vplot{max-width:100%}#viewer canvas.vcmp{width:200px;height:200px;max-width:40vw;max-height:40vw}
+.vlist label{display:block;font-size:0.9em}
 #viewer canvas#v-orig,#viewer canvas#v-approx,#viewer canvas#v-diff{width:256px;height:256px;max-width:28vw;max-height:28vw;cursor:crosshair}
 #viewer canvas#v-slice-orig,#viewer canvas#v-slice-approx{width:180px;height:180px;image-rendering:pixelated}code{background:#f6f6f6;padding:0 3px}
 pre{background:#f6f6f6;padding:0.8em;overflow:auto;font-size:0.85em}
