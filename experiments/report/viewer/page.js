@@ -183,7 +183,7 @@ function bar(cv, label, lo, hi, ramp, log) {
 }
 const state = {id: null, light: null, cam: [1, 0, 0, 0, 1, 0, 0, 0, 1], yaw: 0, pitch: 0, exposure: 1,
                theta_i: 30 * Math.PI / 180, phi_d: Math.PI / 2, env: true, channel: "mean", log: true,
-               hdr: null, shape: "sphere"};
+               hdr: null, hdrExposure: null, shape: "sphere"};
 const $ = (q) => document.getElementById(q);
 function camMatrix() {
   const cy = Math.cos(state.yaw), sy = Math.sin(state.yaw), cp = Math.cos(state.pitch), sp = Math.sin(state.pitch);
@@ -283,6 +283,13 @@ function draw() {
     drawAll();
   } catch (e) { status.textContent = "viewer error: " + e.message; }
 }
+function whiteOf(A) {
+  const peaks = [];
+  for (let k = 0; k < A.length / 4; ++k) if (A[4 * k + 3]) peaks.push(Math.max(A[4 * k], A[4 * k + 1], A[4 * k + 2]));
+  peaks.sort((a, b) => a - b);
+  const p = peaks.length ? peaks[Math.min(peaks.length - 1, Math.floor(0.99 * peaks.length))] : 0;
+  return p > 0 && isFinite(p) ? 1 / p : 1;
+}
 function drawAll() {
   const id = state.id, r = runs[id], n = 160;
   const u = uniforms();
@@ -291,7 +298,11 @@ function drawAll() {
     A = run(id, 0, 0, n, n, u);
     B = run(id, 0, 1, n, n, u);
   } catch (e) { status.textContent = "shader error: " + e.message; return; }
-  const expo = r.exposure * state.exposure;
+  // Under a loaded map the run's exposure (set for its point light) does not
+  // fit: 1 / the 99th percentile of the original's brightest channel under
+  // the map, as sphere.png's rule, shared with compare mode.
+  state.hdrExposure = state.env && state.hdr ? whiteOf(A) : null;
+  const expo = (state.hdrExposure || r.exposure) * state.exposure;
   const bg = [0.16, 0.16, 0.16];
   put($("v-orig"), n, n, (k) => A[4 * k + 3] ? [0, 1, 2].map((c) => srgb(A[4 * k + c] * expo)) : bg);
   put($("v-approx"), n, n, (k) => A[4 * k + 3] ? [0, 1, 2].map((c) => srgb(B[4 * k + c] * expo)) : bg);
@@ -389,7 +400,7 @@ function drawCompare() {
     return;
   }
   box.hidden = false;
-  const n = cmp.size, r = runs[state.id], expo = r.exposure * state.exposure, bg = [0.16, 0.16, 0.16];
+  const n = cmp.size, r = runs[state.id], expo = (state.hdrExposure || r.exposure) * state.exposure, bg = [0.16, 0.16, 0.16];
   // The shared light: the point light, or a loaded map (not a run's own scene lighting).
   const u = Object.assign(uniforms(), {env: state.env && !!state.hdr, intensity: r.scene.intensity});
   const spheres = picked.map((e) => run(e.id, 0, e.which, n, n, u));

@@ -14,7 +14,10 @@ window.BF_PLOT = (function () {
   // series: [{x: [..], y: [..], label, colour?, dash?}]
   function linePlot(cv, series, opts) {
     const ctx = cv.getContext("2d"), W = cv.width, H = cv.height;
-    const L = 52, R = 8, T = 8, B = 34 + 14 * Math.ceil(series.length / 2);
+    ctx.font = "11px sans-serif";
+    // The legend in two columns when every label fits in half the width, else one.
+    const cols = series.every((s) => ctx.measureText(s.label).width + 30 < (W - 52) / 2) ? 2 : 1;
+    const L = 52, R = 8, T = 8, B = 34 + 14 * Math.ceil(series.length / cols);
     ctx.clearRect(0, 0, W, H);
     ctx.fillStyle = "#fff";
     ctx.fillRect(0, 0, W, H);
@@ -78,7 +81,7 @@ window.BF_PLOT = (function () {
     // Legend: two columns below the axis label.
     ctx.textAlign = "left";
     series.forEach((s, i) => {
-      const x = L + (i % 2) * (W - L) / 2, y = H - B + 40 + 14 * Math.floor(i / 2);
+      const x = L + (i % cols) * (W - L) / 2, y = H - B + 40 + 14 * Math.floor(i / cols);
       ctx.strokeStyle = s.colour || COLOURS[i % COLOURS.length];
       ctx.setLineDash(s.dash || []);
       ctx.beginPath(); ctx.moveTo(x, y - 4); ctx.lineTo(x + 22, y - 4); ctx.stroke();
