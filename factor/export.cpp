@@ -64,23 +64,33 @@ double srgb_encode(double v) {
   return v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(v, 1.0 / 2.4) - 0.055;
 }
 
-// 8-bit sRGB preview (see export.h), size (R*block)^2.
+// 8-bit preview (see export.h), size (R*block)^2: the heat colour map of
+// log10 of the factor value (mean over channels of exp(texel)) over the fixed
+// range [kPreviewLog10Min, kPreviewLog10Max], the same for every term.
+std::array<uint8_t, 3> preview_heat(double t) {
+  static const double stops[5][3] = {{0, 0, 0}, {0.1, 0.15, 0.85}, {0.9, 0.1, 0.2}, {1, 0.85, 0.1}, {1, 1, 1}};
+  t = std::clamp(t, 0.0, 1.0) * 4.0;
+  const int i = std::min(3, int(t));
+  const double u = t - i;
+  std::array<uint8_t, 3> c{};
+  for (int ch = 0; ch < 3; ++ch)
+    c[ch] = uint8_t(std::lround(255.0 * (stops[i][ch] * (1.0 - u) + stops[i + 1][ch] * u)));
+  return c;
+}
+
 std::vector<uint8_t> preview_pixels(const FactorTerm& t, int& size) {
   const int R = t.proj.res;
   const int block = std::max(1, 256 / R);
   size = R * block;
-  double mx = 0.0;
-  for (size_t k = 0; k < size_t(R) * R; ++k)
-    if (t.mask[k])
-      for (int c = 0; c < 3; ++c) mx = std::max(mx, std::exp(double(t.texels[c][k])));
   // One colour per texel, then replicated into its block.
-  std::vector<std::array<uint8_t, 3>> colour(size_t(R) * R, {255, 255, 0});
+  std::vector<std::array<uint8_t, 3>> colour(size_t(R) * R, {128, 128, 128});
   for (size_t k = 0; k < size_t(R) * R; ++k)
-    if (t.mask[k])
-      for (int c = 0; c < 3; ++c) {
-        const double v = mx > 0.0 ? std::exp(double(t.texels[c][k])) / mx : 0.0;
-        colour[k][c] = uint8_t(std::lround(255.0 * srgb_encode(v)));
-      }
+    if (t.mask[k]) {
+      double v = 0.0;
+      for (int c = 0; c < 3; ++c) v += std::exp(double(t.texels[c][k])) / 3.0;
+      const double l = v > 0.0 ? std::log10(v) : kPreviewLog10Min;
+      colour[k] = preview_heat((l - kPreviewLog10Min) / (kPreviewLog10Max - kPreviewLog10Min));
+    }
   std::vector<uint8_t> px(size_t(size) * size * 3);
   for (int y = 0; y < size; ++y)
     for (int x = 0; x < size; ++x) {

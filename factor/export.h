@@ -11,10 +11,15 @@
 //                    res x res; pixel (x, y) = texel (i, j) = (x, y), index
 //                    j*res + i; scanline y = 0 comes first. Texels outside the
 //                    projection mask are 0.
-//   STEM_termK.png   preview: exp of the log texels divided by their maximum
-//                    over the masked texels and channels, sRGB 8 bit, each
-//                    texel a block of max(1, 256/res) pixels; texels outside
-//                    the mask are flat yellow (255, 255, 0).
+//   STEM_termK.png   preview: the factor value v = mean over R, G, B of exp
+//                    of the log texels, as log10 v on a fixed range
+//                    [kPreviewLog10Min, kPreviewLog10Max] (the same for every
+//                    term: not normalized per term; clamped at the ends) in
+//                    the heat colour map black - blue (0.1, 0.15, 0.85) - red
+//                    (0.9, 0.1, 0.2) - yellow (1, 0.85, 0.1) - white at 0,
+//                    1/4, 1/2, 3/4, 1, 8 bit; each texel a block of
+//                    max(1, 256/res) pixels; texels outside the mask are
+//                    flat grey (128, 128, 128), a colour not on the map.
 //   STEM.glsl        vec3 brdf_factor_eval(vec3 wi, vec3 wo), see factor/glsl.h.
 //   STEM.json        the sidecar: HomomorphicFactorization::describe() plus
 //                    format, format_version, texture file names and the
@@ -36,6 +41,9 @@ class Catalogue;
 // Version of the sidecar layout written by write_factorization and the only one
 // load_factorization accepts. Bump when a field changes meaning.
 inline constexpr int kFactorExportFormatVersion = 1;
+// The range of log10 (factor value) that the PNG previews' colour map spans.
+inline constexpr double kPreviewLog10Min = -3.0;
+inline constexpr double kPreviewLog10Max = 3.0;
 // Value of the sidecar's "format" field.
 inline constexpr const char* kFactorExportFormat = "brdf-factor-factorization";
 

@@ -11,6 +11,7 @@
 #include "experiments/common/cli_util.h"
 #include "experiments/report/escape.h"
 #include "experiments/report/viewer.h"
+#include "factor/export.h"
 
 namespace bf {
 
@@ -36,7 +37,13 @@ details.notes summary{cursor:pointer;color:#555}details.notes{max-width:40em;whi
 .run{border:1px solid #ddd;border-radius:6px;padding:0.6em 1em;margin:1em 0}
 .run img.sphere{max-width:100%;image-rendering:pixelated}.run img.tex{height:96px;margin-right:4px;image-rendering:pixelated}
 .files a{margin-right:0.8em;font-size:0.85em}
-.vrow{display:flex;flex-wrap:wrap;gap:1em;align-items:flex-start}.vrow figure{margin:0}
+.texbar{font-size:0.75em;color:#555;display:inline-block;width:240px;vertical-align:top}
+.texbar .ramp{display:block;height:10px;background:linear-gradient(to right,#000,rgb(26,38,217),rgb(230,26,51),rgb(255,217,26),#fff)}
+.texbar span:not(.ramp){display:inline-block;width:33.3%;text-align:center}.texbar span:nth-child(2){text-align:left}
+.texbar span:nth-child(4){text-align:right}
+.vrow{display:flex;flex-wrap:wrap;gap:1em;align-items:flex-start}.vrow figure{margin:0}.vrow figcaption{max-width:420px}
+#viewer canvas.vplot{max-width:100%}#viewer canvas.vcmp{width:200px;height:200px;max-width:40vw;max-height:40vw}
+.vlist label{display:block;font-size:0.9em}
 #viewer canvas#v-orig,#viewer canvas#v-approx,#viewer canvas#v-diff{width:256px;height:256px;max-width:28vw;max-height:28vw;cursor:crosshair}
 #viewer canvas#v-slice-orig,#viewer canvas#v-slice-approx{width:180px;height:180px;image-rendering:pixelated}code{background:#f6f6f6;padding:0 3px}
 pre{background:#f6f6f6;padding:0.8em;overflow:auto;font-size:0.85em}
@@ -246,6 +253,12 @@ void write_report_html(const ExperimentOutput& e, const OutputFiles& f, const st
     for (const auto& p : textures)
       h << "<a href=\"" << url(p) << "\"><img class=\"tex\" loading=\"lazy\" src=\"" << url(p) << "\" alt=\""
         << esc(fs::path(p).filename().string()) << "\"></a>";
+    // The previews' colour map (factor/export.h): one fixed log range for all.
+    if (!textures.empty())
+      h << "<div class=\"texbar\"><span class=\"ramp\"></span><span>10<sup>" << kPreviewLog10Min
+        << "</sup></span><span>1</span><span>10<sup>" << kPreviewLog10Max
+        << "</sup></span><br>factor value (mean RGB), log scale, the same for every texture; grey: outside "
+           "the projection's disk</div>\n";
     h << "<p class=\"files\">";
     for (const auto& file : r.files)
       if (exists_in(dir, file))

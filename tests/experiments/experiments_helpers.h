@@ -1,8 +1,9 @@
 // Helpers shared by the experiments tests: scratch folders, config files,
-// quiet runs, CLI invocation.
+// quiet runs, CLI invocation, report.html in headless Chromium.
 #pragma once
 
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -54,6 +55,39 @@ inline void register_loaders() {
     return true;
   }();
   (void)done;
+}
+
+// Debian's Chromium on the PATH ("" when not installed).
+inline std::string chromium_browser() {
+  for (const char* c : {"chromium", "chromium-browser"})
+    if (std::system(("command -v " + std::string(c) + " > /dev/null 2>&1").c_str()) == 0) return c;
+  return "";
+}
+
+// The headless Chromium command line for report.html's viewer: software
+// WebGL2 (SwiftShader), no sandbox (test containers), then `args`.
+inline std::string chromium_command(const std::string& browser, const std::string& args) {
+  return browser + " --headless --no-sandbox --use-gl=swiftshader --enable-unsafe-swiftshader --disable-gpu-sandbox " +
+         args;
+}
+
+// Opens `page` (report.html) at "#viewer-test" (query `query`, "" for none;
+// extra Chromium flags `flags`), dumps the DOM after load into `dir` and
+// returns the text of the page's <pre id="viewer-test"> (the viewer's test
+// numbers, one JSON object a line). "" when Chromium failed or the element is
+// missing; the caller REQUIREs it non-empty.
+inline std::string viewer_test_output(const std::string& browser, const std::string& page, const std::string& dir,
+                                      const std::string& query = "", const std::string& flags = "") {
+  const std::string dom = dir + "/dom.html";
+  const std::string cmd = chromium_command(browser, flags + " --dump-dom 'file://" + page + query + "#viewer-test' > " +
+                                                        dom + " 2> " + dir + "/chromium.log");
+  if (std::system(cmd.c_str()) != 0) return "";
+  const std::string text = read_text(dom);
+  // (std::regex recurses per character: too deep for a megabyte page.)
+  const size_t at = text.find("<pre id=\"viewer-test\"");
+  if (at == std::string::npos) return "";
+  const size_t open = text.find('>', at) + 1, close = text.find("</pre>", open);
+  return close == std::string::npos ? "" : text.substr(open, close - open);
 }
 
 // Runs an experiment quietly (no plots unless asked); returns the summary.

@@ -11,9 +11,7 @@ using namespace bf;
 using namespace bf_test;
 
 TEST_CASE("viewer: report.html?viewer screenshots are not blank at 800x600 1400x1500 and 1920x1080", "[slow]") {
-  std::string browser;
-  for (const char* c : {"chromium", "chromium-browser"})
-    if (std::system(("command -v " + std::string(c) + " > /dev/null 2>&1").c_str()) == 0) browser = c;
+  const std::string browser = chromium_browser();
   INFO("chromium not installed (scripts/install-deps.sh installs it)");
   REQUIRE(!browser.empty());
   ScratchDir dir;
@@ -34,10 +32,10 @@ texture_size = 8
   REQUIRE(run_quiet(cfg, dir / "out").failed == 0);
   for (const auto& [w, h] : {std::pair{800, 600}, std::pair{1400, 1500}, std::pair{1920, 1080}}) {
     const std::string png = dir / ("shot-" + std::to_string(w) + ".png");
-    const std::string cmd = browser + " --headless --no-sandbox --use-gl=swiftshader --enable-unsafe-swiftshader "
-                            "--disable-gpu-sandbox --hide-scrollbars --window-size=" + std::to_string(w) + "," +
-                            std::to_string(h) + " --screenshot=" + png + " 'file://" + (dir / "out/report.html") +
-                            "?viewer' > " + (dir / "chromium.log") + " 2>&1";
+    const std::string cmd = chromium_command(browser, "--hide-scrollbars --window-size=" + std::to_string(w) + "," +
+                                                          std::to_string(h) + " --screenshot=" + png + " 'file://" +
+                                                          (dir / "out/report.html") + "?viewer' > " +
+                                                          (dir / "chromium.log") + " 2>&1");
     INFO(w << "x" << h);
     REQUIRE(std::system(cmd.c_str()) == 0);
     int pw = 0, ph = 0;

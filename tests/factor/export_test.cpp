@@ -1,6 +1,7 @@
 // Tests of the factor export: round trip through EXR + JSON sidecar, loader
 // validation messages, atomic writes, catalogue registration, and the
 // generated GLSL compiled by glslangValidator.
+#include <array>
 #include <unistd.h>
 
 #include <algorithm>
@@ -264,17 +265,43 @@ TEST_CASE("export: sidecar holds what a renderer needs") {
       }
     }
   }
-  // Preview: upscaled to 256 px, outside-mask texels yellow.
-  int pw = 0, ph = 0;
-  const std::vector<uint8_t> px = bf::read_png_rgb8(files.previews[0], pw, ph);
-  CHECK(pw == 256);
-  CHECK(ph == 256);
-  REQUIRE(px.size() == 256 * 256 * 3);
-  const FactorTerm& t = f.terms()[0];
-  for (int k = 0; k < 16 * 16; ++k) {
-    const int x = (k % 16) * 16 + 8, y = (k / 16) * 16 + 8;
-    const uint8_t* p = &px[(size_t(y) * 256 + x) * 3];
-    if (!t.mask[k]) CHECK((p[0] == 255 && p[1] == 255 && p[2] == 0));
+  // Previews: upscaled to 256 px, outside-mask texels grey; inside, the heat
+  // colour map of log10 (mean over channels of exp(texel)) on the fixed range
+  // [-3, 3], the same for every term (not normalized per term).
+  const auto heat = [](double v) {
+    const double st[5][3] = {{0, 0, 0}, {0.1, 0.15, 0.85}, {0.9, 0.1, 0.2}, {1, 0.85, 0.1}, {1, 1, 1}};
+    const double t = std::clamp((std::log10(v) + 3.0) / 6.0, 0.0, 1.0) * 4.0;
+    const int i = std::min(3, int(t));
+    std::array<int, 3> c{};
+    for (int ch = 0; ch < 3; ++ch) c[ch] = int(std::lround(255.0 * (st[i][ch] + (t - i) * (st[i + 1][ch] - st[i][ch]))));
+    return c;
+  };
+  for (size_t term = 0; term < files.previews.size(); ++term) {
+    int pw = 0, ph = 0;
+    const std::vector<uint8_t> px = bf::read_png_rgb8(files.previews[term], pw, ph);
+    const FactorTerm& t = f.terms()[term];
+    const int R = t.proj.res, block = std::max(1, 256 / R), size = R * block;
+    CHECK(pw == size);
+    CHECK(ph == size);
+    REQUIRE(px.size() == size_t(size) * size * 3);
+    int inside = 0;
+    for (int k = 0; k < R * R; ++k) {
+      const int x = (k % R) * block + block / 2, y = (k / R) * block + block / 2;
+      const uint8_t* p = &px[(size_t(y) * size + x) * 3];
+      if (!t.mask[k]) {
+        CHECK((p[0] == 128 && p[1] == 128 && p[2] == 128));
+        continue;
+      }
+      ++inside;
+      double v = 0;
+      for (int c = 0; c < 3; ++c) v += std::exp(double(t.texels[c][k])) / 3;
+      const auto e = heat(v);
+      INFO("term " << term << " texel " << k << " value " << v);
+      CHECK(std::abs(int(p[0]) - e[0]) <= 1);
+      CHECK(std::abs(int(p[1]) - e[1]) <= 1);
+      CHECK(std::abs(int(p[2]) - e[2]) <= 1);
+    }
+    CHECK(inside > 0);
   }
 }
 

@@ -1,7 +1,7 @@
 uniform sampler2D bf_orig;
 uniform vec3 u_light;
 uniform float u_intensity;
-uniform int u_mode;      // 0 sphere, 1 theta_h-theta_d slice, 2 in-plane lobe
+uniform int u_mode;      // 0 sphere, 1 theta_h-theta_d slice, 2 lobe / Cartesian slice, 3 directional albedo
 uniform int u_which;     // 0 original (tabulation), 1 approximation (exported GLSL)
 uniform vec2 u_size;
 uniform mat3 u_cam;      // world = u_cam * camera
@@ -14,7 +14,37 @@ uniform int u_rule_n;
 // The lighting is read at u_env_rot * (world direction): u_env_rot = R^T for
 // an environment turned by R (dragging the light turns it, see the script).
 uniform mat3 u_env_rot;
+uniform int u_out_of_plane;  // mode 2: 1 for wo in the y-z plane (normal to the incidence plane)
+uniform sampler2D bf_arule;  // mode 3: hemisphere rule, node k at (k % width, k / width): (direction, weight)
+uniform int u_arule_first, u_arule_n;  // mode 3: the nodes summed by this draw
+uniform int u_shape;  // mode 0: 0 unit sphere, 1 torus (ring radius 0.62, tube 0.32, axis tilted 30 deg from the view direction)
 out vec4 o_color;
+
+const float BF_TORUS_R = 0.62, BF_TORUS_T = 0.32, BF_TORUS_TILT = 0.52359878;
+// Camera frame -> torus frame (axis z): a rotation by the tilt about x.
+vec3 bf_to_torus(vec3 p) { float c = cos(BF_TORUS_TILT), s = sin(BF_TORUS_TILT); return vec3(p.x, c * p.y + s * p.z, -s * p.y + c * p.z); }
+vec3 bf_from_torus(vec3 p) { float c = cos(BF_TORUS_TILT), s = sin(BF_TORUS_TILT); return vec3(p.x, c * p.y - s * p.z, s * p.y + c * p.z); }
+float bf_torus_sdf(vec3 q) { return length(vec2(length(q.xy) - BF_TORUS_R, q.z)) - BF_TORUS_T; }
+// The orthographic ray through (px, py) towards -z (camera frame): the first
+// hit on the torus by sphere tracing (the SDF is exact, so steps never pass
+// the surface), then the surface point and its normal; false on a miss.
+bool bf_torus_hit(float px, float py, out vec3 pos, out vec3 nrm) {
+  vec3 o = bf_to_torus(vec3(px, py, 2.0)), d = bf_to_torus(vec3(0.0, 0.0, -1.0));
+  float t = 0.0;
+  for (int k = 0; k < 200; ++k) {
+    float h = bf_torus_sdf(o + t * d);
+    if (h < 1e-6) break;
+    t += h;
+    if (t > 4.0) return false;
+  }
+  vec3 q = o + t * d;
+  if (bf_torus_sdf(q) > 1e-4) return false;
+  float rho = length(q.xy);
+  vec3 core = rho > 0.0 ? vec3(q.xy * (BF_TORUS_R / rho), 0.0) : vec3(BF_TORUS_R, 0.0, 0.0);
+  pos = bf_from_torus(q);
+  nrm = bf_from_torus(normalize(q - core));
+  return true;
+}
 
 // Bilinear lookup of the lat-long map (theta = pi (y + 1/2) / H, phi = 2 pi (x + 1/2) / W),
 // wrapping in phi, clamped in theta.
@@ -94,15 +124,25 @@ void main() {
   float px = -1.0 + 2.0 * f.x / u_size.x;
   float py = 1.0 - 2.0 * (u_size.y - f.y) / u_size.y;
   if (u_mode == 0) {
-    float rr = px * px + py * py;
-    if (rr >= 1.0) { o_color = vec4(0.0); return; }
-    vec3 n = u_cam * vec3(px, py, sqrt(1.0 - rr));
+    // The surface point P and normal n in the world (the unit sphere: P = n).
+    vec3 n, P;
+    if (u_shape == 1) {
+      vec3 pc, nc;
+      if (!bf_torus_hit(px, py, pc, nc)) { o_color = vec4(0.0); return; }
+      n = u_cam * nc;
+      P = u_cam * pc;
+    } else {
+      float rr = px * px + py * py;
+      if (rr >= 1.0) { o_color = vec4(0.0); return; }
+      n = u_cam * vec3(px, py, sqrt(1.0 - rr));
+      P = n;
+    }
     vec3 wo_w = u_cam * vec3(0.0, 0.0, 1.0);
     vec3 t = vec3(1.0, 0.0, 0.0) - n.x * n;
     if (length(t) < 1e-9) t = vec3(0.0, 1.0, 0.0) - n.y * n;
     t = normalize(t);
     vec3 b = cross(n, t);
-    vec3 tl = u_light - n;
+    vec3 tl = u_light - P;
     float d2 = dot(tl, tl);
     vec3 wiw = tl / sqrt(d2);
     float ci = dot(wiw, n);
@@ -131,12 +171,26 @@ void main() {
     vec3 wi = vec3(cos(th) * d.x + sin(th) * d.z, d.y, -sin(th) * d.x + cos(th) * d.z);
     vec3 wo = 2.0 * dot(wi, h) * h - wi;
     o_color = vec4(bf_eval(normalize(wi), normalize(wo)), 1.0);
-  } else {
-    // In-plane lobe: wi at theta_i in the x-z plane (phi = 0), wo at theta_o in
-    // [-90, 90] degrees along x (negative: the phi = 180 side).
+  } else if (u_mode == 2) {
+    // Lobe: wi at theta_i in the x-z plane (phi = 0), wo at theta_o in
+    // [-90, 90] degrees along x (negative: the phi = 180 side), or along y
+    // (out of the incidence plane: phi = 90, negative phi = 270).
     float to = -0.5 * 3.14159265 + 3.14159265 * (f.x / u_size.x);
     vec3 wi = vec3(sin(u_theta_i), 0.0, cos(u_theta_i));
-    vec3 wo = vec3(sin(to), 0.0, cos(to));
+    vec3 wo = u_out_of_plane == 1 ? vec3(0.0, sin(to), cos(to)) : vec3(sin(to), 0.0, cos(to));
     o_color = vec4(bf_eval(wi, wo), 1.0);
+  } else {
+    // Directional albedo a(wo) = integral of f(wi, wo) cos theta_i over the
+    // hemisphere by the rule bf_arule, wo at theta_o = 90 deg (x + 1/2) / width
+    // in the x-z plane (phi_o = 0).
+    float to = 0.5 * 3.14159265 * (f.x / u_size.x);
+    vec3 wo = vec3(sin(to), 0.0, cos(to));
+    vec3 a = vec3(0.0);
+    int rw = textureSize(bf_arule, 0).x;
+    for (int k = u_arule_first; k < u_arule_first + u_arule_n; ++k) {
+      vec4 node = texelFetch(bf_arule, ivec2(k % rw, k / rw), 0);
+      a += node.w * node.z * bf_eval(node.xyz, wo);
+    }
+    o_color = vec4(a, 1.0);
   }
 }

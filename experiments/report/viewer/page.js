@@ -15,6 +15,7 @@ if (!gl) { status.textContent = "WebGL2 is not available in this browser: the vi
 if (!gl.getExtension("EXT_color_buffer_float")) { status.textContent = "EXT_color_buffer_float missing: the viewer cannot read float results."; return; }
 const VS = "#version 300 es\nvoid main(){vec2 p=vec2(float((gl_VertexID<<1)&2),float(gl_VertexID&2));gl_Position=vec4(p*2.0-1.0,0.0,1.0);}";
 const FS_MAIN = document.getElementById("v-shader-main").textContent;
+const {linePlot} = window.BF_PLOT;
 function b64floats(s) {
   const bin = atob(s), n = bin.length, bytes = new Uint8Array(n);
   for (let i = 0; i < n; ++i) bytes[i] = bin.charCodeAt(i);
@@ -37,6 +38,42 @@ function texture(w, h, data, rgba) {
   for (const p of [gl.TEXTURE_WRAP_S, gl.TEXTURE_WRAP_T]) gl.texParameteri(gl.TEXTURE_2D, p, gl.CLAMP_TO_EDGE);
   return t;
 }
+// Gauss-Legendre nodes and weights on [a, b] (Newton on P_n from Chebyshev
+// starts; converged to double precision).
+function gaussLegendre(n, a, b) {
+  const x = [], w = [];
+  for (let i = 0; i < n; ++i) {
+    let z = Math.cos(Math.PI * (i + 0.75) / (n + 0.5)), dp = 1;
+    for (let it = 0; it < 100; ++it) {
+      let p0 = 1, p1 = z;
+      for (let k = 2; k <= n; ++k) { const p2 = ((2 * k - 1) * z * p1 - (k - 1) * p0) / k; p0 = p1; p1 = p2; }
+      dp = n * (z * p1 - p0) / (z * z - 1);
+      const dz = p1 / dp;
+      z -= dz;
+      if (Math.abs(dz) < 1e-15) break;
+    }
+    x.push(a + (b - a) * (1 - z) / 2);  // ascending
+    w.push((b - a) / ((1 - z * z) * dp * dp));
+  }
+  return {x, w};
+}
+// The hemisphere rule of the albedo curves: ALBEDO_NZ Gauss-Legendre nodes in
+// cos theta on [0, 1] times ALBEDO_NPHI uniform phi = 2 pi (j + 1/2) / NPHI
+// (the library's sphere_rule(NZ, NPHI, 0, 1)), as RGBA floats (direction,
+// weight), node k = i NPHI + j. 64 x 128: within 6e-3 of a 512 x 1024 rule
+// for Cook-Torrance's default lobe at grazing theta_o (32 x 64: 0.046;
+// 128 x 256: 1e-4 but four times slower in software WebGL2).
+const ALBEDO_NZ = 64, ALBEDO_NPHI = 128, ALBEDO_N = 90, ALBEDO_CHUNK = 2048;
+function hemisphereRule(nz, nphi) {
+  const g = gaussLegendre(nz, 0, 1), out = new Float32Array(nz * nphi * 4);
+  for (let i = 0; i < nz; ++i)
+    for (let j = 0; j < nphi; ++j) {
+      const z = g.x[i], r = Math.sqrt(Math.max(0, (1 - z) * (1 + z))), ph = 2 * Math.PI * (j + 0.5) / nphi, k = 4 * (i * nphi + j);
+      out[k] = r * Math.cos(ph); out[k + 1] = r * Math.sin(ph); out[k + 2] = z; out[k + 3] = g.w[i] * 2 * Math.PI / nphi;
+    }
+  return out;
+}
+let aruleTex = null;
 const cache = {};
 function setup(id) {
   if (cache[id]) return cache[id];
@@ -58,6 +95,8 @@ function setup(id) {
   const e = r.environment;
   units.push({name: "bf_env", tex: e ? texture(e.width, e.height, b64floats(e.data)) : texture(2, 2, new Float32Array(12))});
   units.push({name: "bf_rule", tex: e ? texture(e.nodes, 1, b64floats(e.rule), true) : texture(1, 1, new Float32Array(4), true)});
+  aruleTex = aruleTex || texture(ALBEDO_NPHI, ALBEDO_NZ, hemisphereRule(ALBEDO_NZ, ALBEDO_NPHI), true);
+  units.push({name: "bf_arule", tex: aruleTex});
   cache[id] = {prog, units};
   return cache[id];
 }
@@ -71,9 +110,11 @@ function run(id, mode, which, w, h, u) {
   gl.framebufferRenderbuffer(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.RENDERBUFFER, rb);
   gl.viewport(0, 0, w, h);
   gl.useProgram(s.prog);
+  // A loaded environment map (u.hdr) replaces the scene's lighting textures.
+  const hdr = u.env && u.hdr ? u.hdr : null;
   s.units.forEach((t, k) => {
     gl.activeTexture(gl.TEXTURE0 + k);
-    gl.bindTexture(gl.TEXTURE_2D, t.tex);
+    gl.bindTexture(gl.TEXTURE_2D, hdr && t.name === "bf_env" ? hdr.env : hdr && t.name === "bf_rule" ? hdr.rule : t.tex);
     gl.uniform1i(gl.getUniformLocation(s.prog, t.name), k);
   });
   const L = (n) => gl.getUniformLocation(s.prog, n);
@@ -81,17 +122,23 @@ function run(id, mode, which, w, h, u) {
   gl.uniform1i(L("u_which"), which);
   gl.uniform2f(L("u_size"), w, h);
   gl.uniform3fv(L("u_light"), u.light);
-  gl.uniform1f(L("u_intensity"), r.scene.intensity);
+  gl.uniform1f(L("u_intensity"), u.intensity !== undefined ? u.intensity : r.scene.intensity);
   gl.uniformMatrix3fv(L("u_cam"), false, u.cam);
   gl.uniform1f(L("u_theta_i"), u.theta_i);
   gl.uniform1f(L("u_phi_d"), u.phi_d);
-  gl.uniform1i(L("u_env"), u.env && r.environment ? 1 : 0);
-  gl.uniform1i(L("u_rule_n"), r.environment ? r.environment.nodes : 0);
+  gl.uniform1i(L("u_env"), hdr || (u.env && r.environment) ? 1 : 0);
+  gl.uniform1i(L("u_rule_n"), hdr ? hdr.nodes : r.environment ? r.environment.nodes : 0);
   // u.env_rot is R row-major; read as column-major it is R^T, the lookup matrix.
   gl.uniformMatrix3fv(L("u_env_rot"), false, u.env_rot || [1, 0, 0, 0, 1, 0, 0, 0, 1]);
+  gl.uniform1i(L("u_out_of_plane"), u.out_of_plane ? 1 : 0);
+  gl.uniform1i(L("u_shape"), u.shape === "torus" ? 1 : 0);
+  gl.uniform1i(L("u_arule_first"), u.arule_first || 0);
+  gl.uniform1i(L("u_arule_n"), u.arule_n || 0);
   gl.drawArrays(gl.TRIANGLES, 0, 3);
   const px = new Float32Array(w * h * 4);
   gl.readPixels(0, 0, w, h, gl.RGBA, gl.FLOAT, px);
+  // A lost context (e.g. the browser's GPU watchdog) reads back zeros: say so.
+  if (gl.isContextLost()) throw new Error("the WebGL context was lost: reload the page");
   gl.bindFramebuffer(gl.FRAMEBUFFER, null);
   gl.deleteFramebuffer(fb);
   gl.deleteRenderbuffer(rb);
@@ -135,7 +182,8 @@ function bar(cv, label, lo, hi, ramp, log) {
   ctx.textAlign = "center"; ctx.fillText(label, w / 2, 40);
 }
 const state = {id: null, light: null, cam: [1, 0, 0, 0, 1, 0, 0, 0, 1], yaw: 0, pitch: 0, exposure: 1,
-               theta_i: 30 * Math.PI / 180, phi_d: Math.PI / 2, env: true, channel: "mean", log: true};
+               theta_i: 30 * Math.PI / 180, phi_d: Math.PI / 2, env: true, channel: "mean", log: true,
+               hdr: null, hdrExposure: null, shape: "sphere"};
 const $ = (q) => document.getElementById(q);
 function camMatrix() {
   const cy = Math.cos(state.yaw), sy = Math.sin(state.yaw), cp = Math.cos(state.pitch), sp = Math.sin(state.pitch);
@@ -166,9 +214,83 @@ function rotation(a, b) {
 function envRotation(light) { return rotation(unit(runs[state.id].scene.light), unit(light)); }
 function uniforms() {
   return {light: state.light, cam: state.cam, theta_i: state.theta_i, phi_d: state.phi_d, env: state.env,
-          env_rot: envRotation(state.light)};
+          env_rot: envRotation(state.light), hdr: state.hdr, shape: state.shape};
 }
+// Directional albedo of the original (which = 0) or the approximation (1) at
+// ALBEDO_N theta_o (degrees (k + 1/2) 90 / N, phi_o = 0): RGB per theta_o.
+// Computed once per run.
+const albedoCache = {};
+function albedoCurve(id, which) {
+  const key = id + "/" + which;
+  if (!albedoCache[key]) {
+    // In draws of ALBEDO_CHUNK nodes each (a long draw call can trip the
+    // browser's GPU watchdog in software WebGL), summed here.
+    const rgb = Array.from({length: ALBEDO_N}, () => [0, 0, 0]);
+    for (let first = 0; first < ALBEDO_NZ * ALBEDO_NPHI; first += ALBEDO_CHUNK) {
+      const a = run(id, 3, which, ALBEDO_N, 1, {light: [0, 0, 1], cam: [1, 0, 0, 0, 1, 0, 0, 0, 1], theta_i: 0, phi_d: 0,
+                                                arule_first: first, arule_n: Math.min(ALBEDO_CHUNK, ALBEDO_NZ * ALBEDO_NPHI - first)});
+      for (let k = 0; k < ALBEDO_N; ++k) for (let c = 0; c < 3; ++c) rgb[k][c] += a[4 * k + c];
+    }
+    albedoCache[key] = rgb;
+  }
+  return albedoCache[key];
+}
+const albedoX = Array.from({length: ALBEDO_N}, (_, k) => (k + 0.5) * 90 / ALBEDO_N);
+function channelValue(rgb) { return state.channel === "mean" ? (rgb[0] + rgb[1] + rgb[2]) / 3 : rgb[Number(state.channel)]; }
+function channelName() { return state.channel === "mean" ? "mean RGB" : "RGB"[Number(state.channel)]; }
+// The albedo plot: the original and the approximation against theta_o, the
+// region albedo > 1 shaded red, the theta_o where a curve enters it listed.
+function drawAlbedo(id) {
+  const curves = [["original", 0, []], ["approximation", 1, [5, 3]]].map(([label, which, dash]) =>
+    ({label, dash, x: albedoX, y: albedoCurve(id, which).map(channelValue)}));
+  const top = Math.max(1.1, 1.05 * Math.max(...curves.map((c) => Math.max(...c.y))));
+  linePlot($("v-albedo"), curves, {xmin: 0, xmax: 90, xticks: [0, 15, 30, 45, 60, 75, 90], xlabel: "theta_o (deg), phi_o = 0",
+                                   ylabel: "albedo (" + channelName() + ")", log: false, ymax: top,
+                                   band: {y0: 1, y1: top, colour: "rgba(214, 39, 40, 0.12)"}});
+  const over = curves.map((c) => {
+    const k = c.y.findIndex((v) => v > 1);
+    return k < 0 ? c.label + ": albedo <= 1 everywhere" : c.label + ": albedo > 1 from theta_o = " + albedoX[k].toFixed(1) + " deg";
+  });
+  $("v-albedo-note").textContent = over.join("; ") + " (shaded: albedo > 1).";
+}
+// Cartesian slices: f against theta_o in [-90, 90] at the theta_i slider, in
+// the incidence plane and normal to it, original solid, approximation dashed;
+// the chosen channel, log (4 decades below the peak) or linear.
+const CART_N = 181;
+const cartX = Array.from({length: CART_N}, (_, k) => -90 + 180 * (k + 0.5) / CART_N);
+function cartSeries(id, which, outOfPlane, u) {
+  const P = run(id, 2, which, CART_N, 1, Object.assign({}, u, {out_of_plane: outOfPlane}));
+  const y = [];
+  for (let k = 0; k < CART_N; ++k) y.push(channelValue([P[4 * k], P[4 * k + 1], P[4 * k + 2]]));
+  return y;
+}
+function drawCartesian(entries, u, canvases) {
+  for (const [cid, out] of [[canvases[0], false], [canvases[1], true]]) {
+    const series = entries.map((e) => ({label: e.label, dash: e.dash, colour: e.colour, x: cartX, y: cartSeries(e.id, e.which, out, u)}));
+    let peak = 0;
+    for (const s of series) for (const v of s.y) peak = Math.max(peak, v);
+    peak = peak > 0 ? peak : 1;
+    linePlot($(cid), series, {xmin: -90, xmax: 90, xticks: [-90, -60, -30, 0, 30, 60, 90],
+                              xlabel: "theta_o (deg), " + (out ? "phi_o = 90 (normal to the incidence plane)" : "phi_o = 0 (incidence plane)"),
+                              ylabel: "f (1/sr, " + channelName() + ")", log: state.log, ymin: peak * 1e-4, ymax: peak * 1.1});
+    $(cid).dataset.thetaI = String(u.theta_i);
+  }
+}
+// Every redraw; an error (a shader that does not compile, a lost context) is
+// shown in the status line instead of leaving stale or blank panels unexplained.
 function draw() {
+  try {
+    drawAll();
+  } catch (e) { status.textContent = "viewer error: " + e.message; }
+}
+function whiteOf(A) {
+  const peaks = [];
+  for (let k = 0; k < A.length / 4; ++k) if (A[4 * k + 3]) peaks.push(Math.max(A[4 * k], A[4 * k + 1], A[4 * k + 2]));
+  peaks.sort((a, b) => a - b);
+  const p = peaks.length ? peaks[Math.min(peaks.length - 1, Math.floor(0.99 * peaks.length))] : 0;
+  return p > 0 && isFinite(p) ? 1 / p : 1;
+}
+function drawAll() {
   const id = state.id, r = runs[id], n = 160;
   const u = uniforms();
   let A, B;
@@ -176,7 +298,11 @@ function draw() {
     A = run(id, 0, 0, n, n, u);
     B = run(id, 0, 1, n, n, u);
   } catch (e) { status.textContent = "shader error: " + e.message; return; }
-  const expo = r.exposure * state.exposure;
+  // Under a loaded map the run's exposure (set for its point light) does not
+  // fit: 1 / the 99th percentile of the original's brightest channel under
+  // the map, as sphere.png's rule, shared with compare mode.
+  state.hdrExposure = state.env && state.hdr ? whiteOf(A) : null;
+  const expo = (state.hdrExposure || r.exposure) * state.exposure;
   const bg = [0.16, 0.16, 0.16];
   put($("v-orig"), n, n, (k) => A[4 * k + 3] ? [0, 1, 2].map((c) => srgb(A[4 * k + c] * expo)) : bg);
   put($("v-approx"), n, n, (k) => A[4 * k + 3] ? [0, 1, 2].map((c) => srgb(B[4 * k + c] * expo)) : bg);
@@ -226,12 +352,18 @@ function draw() {
   ctx.setLineDash([]); ctx.fillStyle = "#222"; ctx.font = "11px sans-serif";
   ctx.fillText("radius: f (mean RGB), full scale " + fmt(fmax) + " 1/sr; grey: light at " +
                Math.round(state.theta_i * 180 / Math.PI) + " deg", 6, H - 4);
+  drawAlbedo(id);
+  drawCartesian([{id, which: 0, label: "original", colour: "#1f77b4"}, {id, which: 1, label: "approximation", colour: "#d62728", dash: [5, 3]}], u,
+                ["v-cart-in", "v-cart-out"]);
+  drawCompare();
+  const turned = ", turned " + Math.round(Math.acos(Math.min(1, Math.max(-1, (u.env_rot[0] + u.env_rot[4] + u.env_rot[8] - 1) / 2))) *
+                                         180 / Math.PI) + " deg with the light";
   $("v-info").textContent = r.label + " (" + r.method + "), " +
-      (state.env && r.environment ? "lit by the scene's SH lighting (" + r.environment.nodes + " hemisphere nodes per pixel), turned " +
-                                    Math.round(Math.acos(Math.min(1, Math.max(-1, (u.env_rot[0] + u.env_rot[4] + u.env_rot[8] - 1) / 2))) * 180 / Math.PI) +
-                                    " deg with the light"
+      (state.env && state.hdr ? "lit by " + state.hdr.name + " (" + state.hdr.width + " x " + state.hdr.height + ", SH order " +
+                                state.hdr.order + ", " + state.hdr.nodes + " hemisphere nodes per pixel)" + turned
+      : state.env && r.environment ? "lit by the scene's SH lighting (" + r.environment.nodes + " hemisphere nodes per pixel)" + turned
                                   : "point light (" + state.light.map((v) => v.toFixed(2)).join(", ") + ")") +
-      ", view yaw " + Math.round(state.yaw * 180 / Math.PI) + " pitch " + Math.round(state.pitch * 180 / Math.PI) + " deg";
+      ", " + state.shape + ", view yaw " + Math.round(state.yaw * 180 / Math.PI) + " pitch " + Math.round(state.pitch * 180 / Math.PI) + " deg";
   // Factor textures with their value scale.
   const tx = $("v-textures");
   tx.textContent = r.textures.length ? "" : "No factor textures: the " +
@@ -250,6 +382,120 @@ function draw() {
     tx.appendChild(fig);
   });
 }
+// Compare mode: any two or more entries (a run's approximation, or the
+// original BRDF of a run) side by side under one point light (the shown run's
+// light and intensity, moved by dragging its spheres) and one exposure (the
+// shown run's times the slider); their Cartesian slices and albedo curves
+// overlaid with a legend; the difference of two of them (A - B, per channel;
+// shown as mean |A - B| in the heat map of the |difference| panel).
+const cmp = {picked: [], a: 0, b: 1, size: 160, last: null};
+function entryLabel(e) { return e.id + " " + (e.which ? "approx." : "original") + ": " + files.find((f) => f.id === e.id).label; }
+function drawCompare() {
+  const box = $("v-cmp-out");
+  if (!box) return;
+  const picked = cmp.picked.filter((e) => runs[e.id]);
+  if (picked.length < 2 || !state.id) {
+    box.hidden = true;
+    cmp.last = null;
+    return;
+  }
+  box.hidden = false;
+  const n = cmp.size, r = runs[state.id], expo = (state.hdrExposure || r.exposure) * state.exposure, bg = [0.16, 0.16, 0.16];
+  // The shared light: the point light, or a loaded map (not a run's own scene lighting).
+  const u = Object.assign(uniforms(), {env: state.env && !!state.hdr, intensity: r.scene.intensity});
+  const spheres = picked.map((e) => run(e.id, 0, e.which, n, n, u));
+  const row = $("v-cmp-spheres");
+  row.textContent = "";
+  picked.forEach((e, i) => {
+    const fig = document.createElement("figure"), cv = document.createElement("canvas"), cap = document.createElement("figcaption");
+    cv.className = "vcmp";
+    put(cv, n, n, (k) => spheres[i][4 * k + 3] ? [0, 1, 2].map((c) => srgb(spheres[i][4 * k + c] * expo)) : bg);
+    cap.textContent = String.fromCharCode(65 + i) + ": " + entryLabel(e);
+    fig.appendChild(cv); fig.appendChild(cap); row.appendChild(fig);
+  });
+  for (const [sid, k] of [["v-cmp-a", "a"], ["v-cmp-b", "b"]]) {
+    const el = $(sid);
+    el.textContent = "";
+    picked.forEach((e, i) => {
+      const o = document.createElement("option");
+      o.value = String(i); o.textContent = String.fromCharCode(65 + i) + ": " + entryLabel(e);
+      el.appendChild(o);
+    });
+    if (!(cmp[k] < picked.length)) cmp[k] = k === "a" ? 0 : 1;
+    el.value = String(cmp[k]);
+  }
+  const A = spheres[cmp.a], B = spheres[cmp.b], diff = new Float32Array(n * n * 3);
+  for (let k = 0; k < n * n; ++k) for (let c = 0; c < 3; ++c) diff[3 * k + c] = A[4 * k + c] - B[4 * k + c];
+  put($("v-cmp-diff"), n, n, (k) => {
+    if (!A[4 * k + 3]) return bg;
+    return heat((Math.abs(diff[3 * k]) + Math.abs(diff[3 * k + 1]) + Math.abs(diff[3 * k + 2])) / 3 * expo / 0.25);
+  });
+  bar($("v-cmp-bar"), "|" + String.fromCharCode(65 + cmp.a) + " - " + String.fromCharCode(65 + cmp.b) + "| (mean RGB)", 0, 0.25 / expo, heat, false);
+  const entries = picked.map((e, i) => ({id: e.id, which: e.which, label: String.fromCharCode(65 + i) + ": " + entryLabel(e),
+                                         dash: e.which ? [] : [5, 3]}));
+  drawCartesian(entries, u, ["v-cmp-in", "v-cmp-out-plane"]);
+  linePlot($("v-cmp-albedo"), entries.map((e) => ({label: e.label, dash: e.dash, x: albedoX, y: albedoCurve(e.id, e.which).map(channelValue)})),
+           {xmin: 0, xmax: 90, xticks: [0, 15, 30, 45, 60, 75, 90], xlabel: "theta_o (deg), phi_o = 0", ylabel: "albedo (" + channelName() + ")",
+            log: false, ymax: Math.max(1.1, ...entries.map((e) => 1.05 * Math.max(...albedoCurve(e.id, e.which).map(channelValue)))),
+            band: {y0: 1, y1: 1e9, colour: "rgba(214, 39, 40, 0.12)"}});
+  cmp.last = {entries: picked, spheres, diff, size: n};
+}
+// Loads every picked run's viewer.js, then draws.
+function pickCompare() {
+  cmp.picked = Array.from(document.querySelectorAll("#v-cmp-list input:checked")).map((el) => ({id: el.dataset.run, which: Number(el.dataset.which)}));
+  const missing = cmp.picked.map((e) => e.id).filter((id) => !runs[id]);
+  if (missing.length) ensure(missing[0], pickCompare);
+  else drawCompare();
+}
+{
+  const list = $("v-cmp-list"), seen = new Set();
+  files.forEach((f) => {
+    const brdf = f.label.split(" | ")[0];
+    const kinds = seen.has(brdf) ? [1] : [1, 0];
+    seen.add(brdf);
+    for (const which of kinds) {
+      const lab = document.createElement("label"), box = document.createElement("input");
+      box.type = "checkbox"; box.dataset.run = f.id; box.dataset.which = String(which);
+      box.onchange = pickCompare;
+      lab.appendChild(box);
+      lab.appendChild(document.createTextNode(" " + entryLabel({id: f.id, which}) + (which ? "" : " (the BRDF, tabulated)")));
+      list.appendChild(lab);
+    }
+  });
+  $("v-cmp-a").onchange = (e) => { cmp.a = Number(e.target.value); drawCompare(); };
+  $("v-cmp-b").onchange = (e) => { cmp.b = Number(e.target.value); drawCompare(); };
+}
+// A Radiance .hdr picked in the page lights every sphere (the shown run's and
+// compare mode's): band-limited to SH order HDR_ORDER as the toolkit's scene
+// lighting (hdr.js), shaded by the run's exported GLSL with LitShader's rule.
+const HDR_ORDER = 8, HDR_GRID = 128;
+function useHdr(map, name) {
+  const nz = Math.max(16, HDR_ORDER + 8);
+  state.hdr = {name, width: map.width, height: map.height, order: HDR_ORDER, nodes: nz * 2 * nz,
+               env: texture(HDR_GRID, HDR_GRID / 2, window.BF_HDR.bandLimited(map, HDR_ORDER, HDR_GRID)),
+               rule: texture(nz * 2 * nz, 1, hemisphereRule(nz, 2 * nz), true)};
+  state.env = true;
+  $("v-env").checked = true;
+  $("v-env").disabled = false;
+  if (state.id) draw();
+}
+// The bytes of a picked file: parsed, band-limited and drawn, or refused in
+// the status line (the lighting unchanged).
+function loadHdrBytes(bytes, name) {
+  try {
+    useHdr(window.BF_HDR.parseHdr(bytes, name), name);
+    status.textContent = "";
+  } catch (err) { status.textContent = err.message; }
+}
+$("v-hdr").onchange = (e) => {
+  const f = e.target.files[0];
+  if (!f) return;
+  status.textContent = "reading " + f.name + " ...";
+  const rd = new FileReader();
+  rd.onload = () => loadHdrBytes(new Uint8Array(rd.result), f.name);
+  rd.onerror = () => { status.textContent = f.name + ": cannot read the file"; };
+  rd.readAsArrayBuffer(f);
+};
 // Controls.
 const sel = $("v-run");
 files.forEach((f) => { const o = document.createElement("option"); o.value = f.id; o.textContent = f.id + "  " + f.label; sel.appendChild(o); });
@@ -268,21 +514,26 @@ function show(id) {
     state.id = id;
     sel.value = id;
     state.light = runs[id].scene.light.slice();
-    $("v-env").disabled = !runs[id].environment;
-    draw();
+    $("v-env").disabled = !runs[id].environment && !state.hdr;
     status.textContent = "";
+    draw();
   });
 }
 sel.onchange = () => show(sel.value);
 $("v-env").onchange = (e) => { state.env = e.target.checked; draw(); };
 $("v-exposure").oninput = (e) => { state.exposure = Math.pow(2, +e.target.value); draw(); };
-$("v-theta").oninput = (e) => { state.theta_i = +e.target.value * Math.PI / 180; draw(); };
+$("v-theta").oninput = (e) => {
+  state.theta_i = +e.target.value * Math.PI / 180;
+  $("v-theta-val").textContent = e.target.value;
+  draw();
+};
 $("v-phid").oninput = (e) => {
   state.phi_d = +e.target.value * Math.PI / 180;
   $("v-phid-val").textContent = e.target.value;
   draw();
 };
 $("v-channel").onchange = (e) => { state.channel = e.target.value; draw(); };
+$("v-shape").onchange = (e) => { state.shape = e.target.value; draw(); };
 $("v-log").onchange = (e) => { state.log = e.target.checked; draw(); };
 $("v-reset").onclick = () => { state.light = runs[state.id].scene.light.slice(); state.yaw = state.pitch = 0; state.cam = camMatrix(); draw(); };
 for (const pid of ["v-orig", "v-approx", "v-diff"]) {
@@ -318,6 +569,12 @@ if (testMode) {
       rec.slice = pick(run(id, 1, 1, 16, 16, u), 16, 16);
       rec.lobe = pick(run(id, 2, 1, 32, 1, u), 32, 1);
       rec.lobe_original = pick(run(id, 2, 0, 32, 1, u), 32, 1);
+      // Albedo curves (8192 nodes x 90 theta_o each, slow in software
+      // WebGL): the first run's, which the page draws.
+      if (id === ids[0]) {
+        rec.albedo = [].concat(...albedoCurve(id, 1));
+        rec.albedo_original = [].concat(...albedoCurve(id, 0));
+      }
       if (r.environment) {
         const ue = Object.assign({}, u, {env: true});
         rec.approx_env = pick(run(id, 0, 1, n, n, ue), n, n);
@@ -371,5 +628,88 @@ if (testMode) {
   for (let k = 0; k < 256; ++k) slice.push(sl[4 * k], sl[4 * k + 1], sl[4 * k + 2]);
   $("viewer-test").textContent += "\n" + JSON.stringify({phid: {run: state.id, phi_d: state.phi_d, slice,
       canvas_before: before, canvas_after: canvasMean(), label: $("v-phid-val").textContent, status: status.textContent}});
+  // The checks below do not need the scene's lighting, and every handler
+  // redraws the spheres (under SH lighting 512 nodes a pixel): point light.
+  $("v-env").checked = false;
+  $("v-env").dispatchEvent(new Event("change"));
+  // The theta_i slider moved to 50 deg and the channel set to G through their
+  // handlers: the Cartesian slices as plotted (data-series of their canvases),
+  // and the albedo plot's curves.
+  $("v-theta").value = "50";
+  $("v-theta").dispatchEvent(new Event("input"));
+  $("v-channel").value = "1";
+  $("v-channel").dispatchEvent(new Event("change"));
+  const series = (cid) => JSON.parse($(cid).dataset.series);
+  $("viewer-test").textContent += "\n" + JSON.stringify({cart: {run: state.id, theta_i: state.theta_i, label: $("v-theta-val").textContent,
+      in_plane: series("v-cart-in"), out_of_plane: series("v-cart-out"), albedo_plot: series("v-albedo"),
+      albedo_note: $("v-albedo-note").textContent, status: status.textContent}});
+  // Compare: the first two runs' approximations and the last run's original
+  // ticked through their checkboxes' handlers, drawn at the scene's size
+  // (theta_i back to 30 deg, the mean channel); A - B of the first two.
+  $("v-theta").value = "30";
+  $("v-theta").dispatchEvent(new Event("input"));
+  $("v-channel").value = "mean";
+  $("v-channel").dispatchEvent(new Event("change"));
+  cmp.size = runs[ids[0]].scene.size;
+  const boxes = Array.from(document.querySelectorAll("#v-cmp-list input"));
+  const tick = (id, which) => {
+    const box = boxes.find((el) => el.dataset.run === id && Number(el.dataset.which) === which);
+    if (box) { box.checked = true; box.dispatchEvent(new Event("change")); }
+  };
+  if (ids.length >= 2) {
+    tick(ids[0], 1);
+    tick(ids[1], 1);
+    tick(ids[ids.length - 1], 0);
+    const rgb = (a) => { const v = []; for (let k = 0; k < a.length / 4; ++k) v.push(a[4 * k], a[4 * k + 1], a[4 * k + 2]); return v; };
+    const last = cmp.last || {entries: [], spheres: [], diff: []};
+    $("viewer-test").textContent += "\n" + JSON.stringify({compare: {entries: last.entries, size: cmp.size,
+        spheres: last.spheres.map(rgb), diff: Array.from(last.diff), a: cmp.a, b: cmp.b, in_plane: series("v-cmp-in"),
+        theta_i: state.theta_i, light: state.light, hidden: $("v-cmp-out").hidden,
+        spheres_drawn: document.querySelectorAll("#v-cmp-spheres canvas").length, status: status.textContent}});
+  }
+  // The shape set to the torus through its handler: the first run's
+  // approximation on it at the scene's size and light (no environment).
+  $("v-shape").value = "torus";
+  $("v-shape").dispatchEvent(new Event("change"));
+  {
+    const r = runs[ids[0]], n = r.scene.size;
+    const a = run(ids[0], 0, 1, n, n, {light: r.scene.light, cam: [1, 0, 0, 0, 1, 0, 0, 0, 1], theta_i: 0, phi_d: 0, shape: state.shape});
+    const v = [], mask = [];
+    for (let k = 0; k < n * n; ++k) { v.push(a[4 * k], a[4 * k + 1], a[4 * k + 2]); mask.push(a[4 * k + 3]); }
+    $("viewer-test").textContent += "\n" + JSON.stringify({torus: {run: ids[0], size: n, radiance: v, mask, status: status.textContent,
+        info: $("v-info").textContent}});
+  }
+  $("v-shape").value = "sphere";
+  $("v-shape").dispatchEvent(new Event("change"));
+  // "?hdr=PATH" (a file beside the page; Chromium needs
+  // --allow-file-access-from-files): its bytes, read by a synchronous
+  // XMLHttpRequest, go to loadHdrBytes, the function the file input's change
+  // handler calls once its FileReader has the bytes (that asynchronous read
+  // would race the headless DOM dump); then per run the approximation's
+  // sphere under the map at the scene's size (environment not turned).
+  const hdrPath = new URLSearchParams(location.search).get("hdr");
+  if (hdrPath) {
+    const xhr = new XMLHttpRequest();
+    let bytes = null;
+    try {
+      xhr.open("GET", hdrPath, false);
+      xhr.overrideMimeType("text/plain; charset=x-user-defined");
+      xhr.send();
+      const t = xhr.responseText;
+      bytes = new Uint8Array(t.length);
+      for (let k = 0; k < t.length; ++k) bytes[k] = t.charCodeAt(k) & 0xff;
+    } catch (err) { status.textContent = "cannot read " + hdrPath + ": " + err.message; }
+    if (bytes && bytes.length) loadHdrBytes(bytes, hdrPath.split("/").pop());
+    const rec = {hdr: {status: status.textContent, info: $("v-info").textContent, loaded: !!state.hdr, runs: {}}};
+    if (state.hdr)
+      for (const id of ids) {
+        const n = runs[id].scene.size, a = run(id, 0, 1, n, n, {light: runs[id].scene.light, cam: [1, 0, 0, 0, 1, 0, 0, 0, 1],
+                                                                 theta_i: 0, phi_d: 0, env: true, hdr: state.hdr});
+        const v = [];
+        for (let k = 0; k < n * n; ++k) v.push(a[4 * k], a[4 * k + 1], a[4 * k + 2]);
+        rec.hdr.runs[id] = v;
+      }
+    $("viewer-test").textContent += "\n" + JSON.stringify(rec);
+  }
 }
 })();
