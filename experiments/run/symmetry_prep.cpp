@@ -22,7 +22,22 @@ SampleSet fit_set(const SampleSet& train, const SymmetryChoice& c, OrbitInfo* in
     if (info) *info = {1, 1, train.valid_count(), train.valid_count()};
     return train;
   }
-  return expand_orbit(train, c.used, {}, info);
+  SampleSet orbit = expand_orbit(train, c.used, kRunOrbit, info);
+  SampleSet out;
+  out.description = orbit.description + "; each sample also fitted itself at " +
+                    std::to_string(static_cast<int>(kRawShare * 100)) + "% of its weight";
+  const size_t n = train.valid_count() + orbit.size();
+  out.wi.reserve(n);
+  out.wo.reserve(n);
+  out.value.reserve(n);
+  out.weight.reserve(n);
+  for (size_t k = 0; k < train.size(); ++k)
+    if (train.valid[k]) out.push(train.wi[k], train.wo[k], train.value[k], kRawShare * train.weight_of(k));
+  for (size_t k = 0; k < orbit.size(); ++k)
+    out.push(orbit.wi[k], orbit.wo[k], orbit.value[k], (1.0 - kRawShare) * orbit.weight_of(k));
+  out.validate();
+  if (info) info->samples_out = out.size();
+  return out;
 }
 
 }  // namespace bf

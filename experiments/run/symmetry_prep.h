@@ -27,8 +27,20 @@ struct SymmetryChoice {
 };
 SymmetryChoice choose_symmetries(const SamplingVariant& s, const SampleSet& samples);
 
+// The orbit a run's fit uses: at most 2 staggered rotations per sample (with
+// swap and mirror, 8 copies of a Cornell sample), a 2,000,000-sample budget.
+// The stagger spreads the set over every azimuth already; more rotations cost
+// time and memory without lowering the errors (docs/design.md §4.3).
+inline constexpr OrbitOptions kRunOrbit{2, 2'000'000};
+// The share of each measured sample's weight that stays on the sample itself;
+// its orbit copies share the rest. Without it the fit spends its capacity off
+// the measured slice and the held-out error rises (docs/design.md §4.3).
+inline constexpr double kRawShare = 0.5;
+
 // The set the fit sees: `train` itself (a copy) when nothing is used, else
-// expand_orbit(train, used). info describes the expansion.
+// the valid training samples at kRawShare of their weight followed by
+// expand_orbit(train, used, kRunOrbit) at the rest. info describes the
+// expansion (samples_out counts both parts).
 SampleSet fit_set(const SampleSet& train, const SymmetryChoice& c, OrbitInfo* info);
 
 }  // namespace bf

@@ -4,6 +4,7 @@
 #include "brdfs/catalogue.h"
 #include "brdfs/sample_csv.h"
 #include "experiments/report/outputs.h"
+#include "experiments/run/symmetry_prep.h"
 #include "experiments_helpers.h"
 
 using namespace bf;
@@ -63,7 +64,7 @@ TEST_CASE("symmetry run: measured samples use their declared symmetries unless t
   CHECK(a.at("symmetries") == "isotropic+reciprocal+bilateral");
   CHECK(!a.at("val_rel_mse").empty());
   const std::string rec = read_text(tmp / ("a/runs/" + a.at("run_id") + "/run.json"));
-  CHECK(rec.find("orbit of 96 per sample") != std::string::npos);
+  CHECK(rec.find("orbit of 8 per sample (2 rotations x swap x mirror)") != std::string::npos);
   run_quiet(write_text(tmp / "b.toml",
                        config("model = \"krylon-blue\"", "kind = \"measured\"\nsymmetries = \"off\"", mccool)),
             tmp / "b");
@@ -81,4 +82,30 @@ TEST_CASE("symmetry run: a bad symmetries value names the key and the accepted v
   require_one_config_error("[experiment]\nname = \"t\"\n[[brdf]]\npreset = \"bluepaint\"\n[sampling]\nkind = "
                            "\"grid\"\nresolution = 6\nsymmetries = \"isotropic+round\"\n[[method]]\nkind = \"mccool\"\n",
                            {"sampling.symmetries", "isotropic+round", "bilateral"});
+}
+
+TEST_CASE("symmetry run: the fit set keeps each raw sample at its share and every sample's total weight") {
+  const BrdfPtr ct = Catalogue::builtin().make("cook-torrance");
+  SampleSet s = sample_stratified(*ct, 40, 3);
+  s.value[5] = Rgb::Constant(-1.0);  // masked: dropped from the fit set
+  s.validate();
+  const SymmetryChoice c{Symmetries::all(), Symmetries::all(), "auto"};
+  OrbitInfo info;
+  const SampleSet f = fit_set(s, c, &info);
+  REQUIRE(info.orbit_size == 8);
+  REQUIRE(f.size() == 39 + 39 * 8);
+  CHECK(info.samples_out == f.size());
+  double total = 0;
+  for (size_t k = 0; k < f.size(); ++k) total += f.weight_of(k);
+  CHECK(total == Approx(39.0).epsilon(1e-12));
+  // The raw samples come first, each at half its weight; its 8 orbit copies share the rest.
+  size_t j = 0;
+  for (size_t k = 0; k < s.size(); ++k) {
+    if (!s.valid[k]) continue;
+    CHECK(f.wi[j] == s.wi[k]);
+    CHECK(f.wo[j] == s.wo[k]);
+    CHECK(f.weight_of(j) == Approx(0.5));
+    ++j;
+  }
+  CHECK(f.weight_of(39) == Approx(0.5 / 8));
 }
