@@ -35,6 +35,17 @@ class Brdf {
   virtual bool reciprocal() const { return true; }
   // Whether f is invariant under a common rotation of wi and wo about n.
   virtual bool isotropic() const { return true; }
+  // Whether f is invariant under the mirror y -> -y of both wi and wo
+  // (brdfs/symmetry.h). False unless a model's formula gives it.
+  virtual bool bilateral() const { return false; }
+  // Whether eval is the BRDF over the whole domain (a truth to validate
+  // against). Analytic models and MERL tables: true. An interpolant of
+  // scattered samples: only when the symmetries it assumes are declared by its
+  // data; else false with the reason in *why.
+  virtual bool whole_domain(std::string* why = nullptr) const {
+    (void)why;
+    return true;
+  }
 };
 
 using BrdfPtr = std::shared_ptr<const Brdf>;

@@ -176,12 +176,46 @@ const SampleSet& MeasuredBrdf::samples() const {
   return table_->samples;
 }
 
+bool MeasuredBrdf::reciprocal() const { return table_->samples.symmetries.reciprocal; }
+bool MeasuredBrdf::isotropic() const { return table_->samples.symmetries.isotropic; }
+bool MeasuredBrdf::bilateral() const { return table_->samples.symmetries.bilateral; }
+
+bool MeasuredBrdf::whole_domain(std::string* why) const {
+  const Symmetries& d = table_->samples.symmetries;
+  if (d.covers(interpolant_needs())) return true;
+  if (why)
+    *why = "the interpolant of " + name_ + " assumes isotropic+reciprocal+bilateral, its samples declare " +
+           d.to_string();
+  return false;
+}
+
 SampleSet measured_samples(const Brdf& brdf) {
   if (const auto* m = dynamic_cast<const MeasuredBrdf*>(&brdf)) return m->samples();
   if (const auto* m = dynamic_cast<const MerlBrdf*>(&brdf)) return m->samples(1);
   throw std::invalid_argument(brdf.to_string() +
                               ": not a measured BRDF (expected one loaded from .astm, .brdf, "
                               ".csv or .binary); sample it with a grid or stratified set instead");
+}
+
+BrdfPtr measured_from_training(const Brdf& brdf, const SampleSet& train) {
+  if (const auto* m = dynamic_cast<const MeasuredBrdf*>(&brdf))
+    return std::make_shared<MeasuredBrdf>(m->name(), train, m->options());
+  if (const auto* m = dynamic_cast<const MerlBrdf*>(&brdf)) {
+    if (train.valid_count() == 0)
+      throw std::invalid_argument(brdf.to_string() + ": no valid training sample to make a table of");
+    auto t = std::make_shared<MerlTable>();
+    t->raw.assign(3 * kMerlCells, -1.0);
+    const MerlTable& full = m->table();
+    for (size_t k = 0; k < train.size(); ++k) {
+      if (!train.valid[k]) continue;
+      const MerlAngles a = merl_half_diff(train.wi[k], train.wo[k]);
+      const size_t cell = merl_cell(merl_theta_h_index(a.theta_h), merl_theta_d_index(a.theta_d),
+                                    merl_phi_d_index(a.phi_d));
+      for (int c = 0; c < 3; ++c) t->raw[c * kMerlCells + cell] = full.raw[c * kMerlCells + cell];
+    }
+    return std::make_shared<MerlBrdf>(t, MerlLookup::Linear, m->source() + " (training cells)");
+  }
+  return nullptr;
 }
 
 namespace {

@@ -94,8 +94,9 @@ Vec3 marschner_point(const Vec3& wi, const Vec3& wo);
 // weights ((R - d_j) / (R d_j))^2, value = sum w_j f_j / sum w_j. It
 // reproduces the samples exactly (a query within 1e-12 of a sample returns
 // it), is continuous, stays within the range of the neighbours (so it is
-// non-negative and finite), and is reciprocal and isotropic by construction
-// of the space. Outside the measured angles (e.g. theta > 80 degrees for the
+// non-negative and finite), and is reciprocal, isotropic and bilateral by
+// construction of the space; it claims (isotropic() etc.) only what its
+// samples declare. Outside the measured angles (e.g. theta > 80 degrees for the
 // Cornell data) it extends the nearest measurements; below the horizon it is 0.
 class MeasuredBrdf final : public Brdf {
  public:
@@ -107,8 +108,15 @@ class MeasuredBrdf final : public Brdf {
   Rgb eval(const Vec3& wi, const Vec3& wo) const override;
   std::string name() const override { return name_; }
   std::string to_string() const override;
-  bool reciprocal() const override { return true; }
-  bool isotropic() const override { return true; }
+  // The symmetries the samples declare (SampleSet::symmetries), not those the
+  // interpolation has by construction: the interpolant equals the measured
+  // BRDF over the whole domain only when all three are declared.
+  bool reciprocal() const override;
+  bool isotropic() const override;
+  bool bilateral() const override;
+  // True when the samples declare isotropic, reciprocal and bilateral (what
+  // the interpolation in Marschner's space assumes).
+  bool whole_domain(std::string* why = nullptr) const override;
 
   // The raw measured samples (with validity), for fits that use the measured
   // list directly (thesis 1.3.2).
@@ -126,5 +134,14 @@ class MeasuredBrdf final : public Brdf {
 // MerlBrdf -> one sample per table cell (missing cells masked). Throws
 // std::invalid_argument for any other BRDF, naming it.
 SampleSet measured_samples(const Brdf& brdf);
+
+// The measured BRDF made of `train` only (the samples a fit may see, e.g. the
+// training part of a held-out split): MeasuredBrdf -> the interpolant of
+// `train` with the same name and options (train's declared symmetries);
+// MerlBrdf -> the same table with every cell not in `train` missing, read with
+// trilinear lookup (missing corners dropped and the rest renormalized, so a
+// removed cell is filled from its neighbours). nullptr for any other BRDF.
+// Throws std::invalid_argument when train has no valid sample.
+BrdfPtr measured_from_training(const Brdf& brdf, const SampleSet& train);
 
 }  // namespace bf

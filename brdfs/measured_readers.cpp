@@ -289,6 +289,11 @@ SampleSet spectral_to_samples(const SpectralMeasurements& m, int band_nm, size_t
     os << "rgb (CIE 1931 2deg, equal-energy white -> linear sRGB), " << n_desaturated
        << " desaturated into the sRGB gamut";
   s.description = os.str();
+  // ASTM (Cornell) and pbrt "irregular isotropic" files hold isotropic BRDFs
+  // given as functions of (theta_i, theta_s, |phi_s - phi_i|): isotropic,
+  // reciprocal and bilateral (the Cornell records cover phi_i = 0 and mostly
+  // phi_s < 0, one half-slice of the domain).
+  s.symmetries = Symmetries::all();
   if (desaturated) *desaturated = n_desaturated;
   return s;
 }

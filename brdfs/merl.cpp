@@ -334,6 +334,9 @@ SampleSet MerlBrdf::samples(int stride) const {
         s.push(wi, wo, t.missing(cell) ? Rgb::Constant(-1.0) : t.value(cell));
       }
   s.description = "merl table " + source_ + " (bin centres, stride " + std::to_string(stride) + ")";
+  // The format stores an isotropic, reciprocal BRDF (phi_h dropped, phi_d folded
+  // by reciprocity); it does not assume the mirror phi_d -> -phi_d.
+  s.symmetries = {true, true, false};
   s.validate();
   return s;
 }

@@ -133,6 +133,7 @@ class MerlBrdf final : public Brdf {
   SampleSet samples(int stride = 1) const;
   const MerlTable& table() const { return *table_; }
   MerlLookup lookup() const { return lookup_; }
+  const std::string& source() const { return source_; }
 
  private:
   std::shared_ptr<const MerlTable> table_;

@@ -52,6 +52,8 @@ class Lambert final : public Brdf {
   Rgb eval(const Vec3& wi, const Vec3& wo) const override;
   std::string name() const override { return "lambert"; }
   std::string to_string() const override;
+  // The formula depends on dot products only.
+  bool bilateral() const override { return true; }
   const LambertParams& params() const { return p_; }
 
  private:
@@ -85,6 +87,8 @@ class BlinnPhong final : public Brdf {
   Rgb eval(const Vec3& wi, const Vec3& wo) const override;
   std::string name() const override { return "blinn-phong"; }
   std::string to_string() const override;
+  // The formula depends on dot products only.
+  bool bilateral() const override { return true; }
   const BlinnPhongParams& params() const { return p_; }
 
  private:
@@ -132,6 +136,8 @@ class CookTorrance final : public Brdf {
   Rgb eval(const Vec3& wi, const Vec3& wo) const override;
   std::string name() const override { return "cook-torrance"; }
   std::string to_string() const override;
+  // The formula depends on dot products only.
+  bool bilateral() const override { return true; }
   const CookTorranceParams& params() const { return p_; }
 
  private:
@@ -175,6 +181,8 @@ class Lafortune final : public Brdf {
   Rgb eval(const Vec3& wi, const Vec3& wo) const override;
   std::string name() const override { return "lafortune"; }
   std::string to_string() const override;
+  // The formula depends on wi.y, wo.y, h.y only through even powers or products.
+  bool bilateral() const override { return true; }
   bool isotropic() const override;
   const LafortuneParams& params() const { return p_; }
 
@@ -215,6 +223,8 @@ class Ward final : public Brdf {
   Rgb eval(const Vec3& wi, const Vec3& wo) const override;
   std::string name() const override { return "ward"; }
   std::string to_string() const override;
+  // The formula depends on wi.y, wo.y, h.y only through even powers or products.
+  bool bilateral() const override { return true; }
   bool isotropic() const override { return p_.ax == p_.ay; }
   const WardParams& params() const { return p_; }
 
@@ -250,6 +260,8 @@ class AshikhminShirley final : public Brdf {
   Rgb eval(const Vec3& wi, const Vec3& wo) const override;
   std::string name() const override { return "ashikhmin-shirley"; }
   std::string to_string() const override;
+  // The formula depends on wi.y, wo.y, h.y only through even powers or products.
+  bool bilateral() const override { return true; }
   bool isotropic() const override { return p_.nu == p_.nv; }
   const AshikhminShirleyParams& params() const { return p_; }
 
@@ -288,6 +300,8 @@ class Separable final : public Brdf {
   Rgb eval(const Vec3& wi, const Vec3& wo) const override;
   std::string name() const override { return "separable"; }
   std::string to_string() const override;
+  // True when no factor has a term odd in v (c2 = c4 = 0).
+  bool bilateral() const override;
   bool reciprocal() const override { return p_.a == p_.b; }
   bool isotropic() const override;
   const SeparableParams& params() const { return p_; }
@@ -311,6 +325,8 @@ class McCoolForm final : public Brdf {
   Rgb eval(const Vec3& wi, const Vec3& wo) const override;
   std::string name() const override { return "mccool-form"; }
   std::string to_string() const override;
+  // True when no factor has a term odd in v (c2 = c4 = 0).
+  bool bilateral() const override;
   bool isotropic() const override;
   const McCoolFormParams& params() const { return p_; }
 

@@ -89,6 +89,14 @@ Rgb Separable::eval(const Vec3& wi, const Vec3& wo) const {
   return p_.a.eval(wi) * p_.b.eval(wo) * p_.c.eval(h);
 }
 
+namespace {
+bool even_in_v(const ExpQuadratic& q) { return (q.c[2] == 0.0).all() && (q.c[4] == 0.0).all(); }
+}  // namespace
+
+bool Separable::bilateral() const { return even_in_v(p_.a) && even_in_v(p_.b) && even_in_v(p_.c); }
+
+bool McCoolForm::bilateral() const { return even_in_v(p_.p) && even_in_v(p_.q); }
+
 bool Separable::isotropic() const {
   return p_.a.rotation_invariant() && p_.b.rotation_invariant() && p_.c.rotation_invariant();
 }

@@ -58,6 +58,7 @@ std::string SampleSet::summary() const {
 SampleSet SampleSet::compacted() const {
   SampleSet out;
   out.description = description;
+  out.symmetries = symmetries;
   for (size_t k = 0; k < size(); ++k)
     if (valid[k]) out.push(wi[k], wo[k], value[k], weight_of(k));
   out.validate();

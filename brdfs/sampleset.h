@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "brdfs/brdf.h"
+#include "brdfs/symmetry.h"
 
 namespace bf {
 
@@ -19,6 +20,11 @@ struct SampleSet {
   std::vector<double> weight; // empty = every weight is 1; else >= 0 per sample
   std::vector<uint8_t> valid; // 1 = used by fits and metrics, 0 = masked
   std::string description;    // provenance, e.g. "grid 16^4 of bluepaint"
+  // What the data guarantee of the BRDF they sample (brdfs/symmetry.h):
+  // readers declare what their format guarantees (ASTM, pbrt .brdf: all
+  // three; MERL cells: isotropic + reciprocal; CSV: none), a config or
+  // bf.SampleSet may declare more. Builders from a BRDF leave it none.
+  Symmetries symmetries;
 
   // Counts of masked samples by reason (filled by validate()).
   size_t invalid_value = 0;    // NaN, Inf or negative in any channel

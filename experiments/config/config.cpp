@@ -50,7 +50,7 @@ const std::map<std::string, std::vector<std::string>>& key_table() {
       {"top", {"experiment", "brdf", "sampling", "method", "scene"}},
       {"experiment", {"name", "seed", "out", "description", "jobs", "plots", "render", "export",
                       "metric_eps", "validation_pairs", "holdout"}},
-      {"sampling", {"kind", "resolution", "count", "seed", "path", "zip"}},
+      {"sampling", {"kind", "resolution", "count", "seed", "path", "zip", "symmetries"}},
       {"scene", {"shade_rmse", "light", "intensity", "size", "environment", "environment_eps", "lighting_order",
                  "lighting_nodes"}},
       {"brdf", {"preset", "model", "file", "name", "zip"}},
@@ -365,6 +365,25 @@ void read_samplings(const toml::node* node, Ctx& ctx, uint64_t base_seed,
         s.label = "measured";
         s.identity = {{"kind", "measured"}};
       }
+      // Symmetries the fit's raw samples stand for (experiments/run/symmetry_prep.h).
+      // Raw samples record the key in their identity (their results depend on it);
+      // grid and stratified sets only when it is set to something other than "auto".
+      s.symmetries = r.text("symmetries", "auto");
+      if (!r.failed() && s.symmetries != "auto" && s.symmetries != "off") {
+        try {
+          parse_symmetries(s.symmetries, "symmetries");
+        } catch (const std::invalid_argument&) {
+          r.fail("symmetries", "expected \"auto\", \"off\", \"none\" or names joined by '+' (isotropic, "
+                               "reciprocal, bilateral), found \"" + s.symmetries + "\"");
+        }
+      }
+      if (s.kind == "measured" || s.kind == "file" || s.symmetries != "auto") {
+        s.identity["symmetries"] = s.symmetries;
+        // The orbit's settings are code constants: in the identity, so that
+        // changing them never reuses a run cached under the old ones.
+        if (s.symmetries != "off" && s.symmetries != "none") s.identity["orbit"] = orbit_identity();
+      }
+      if (s.symmetries != "auto") s.label += " symmetries " + s.symmetries;
       for (const auto& key : {"resolution", "count", "seed", "path"}) {
         if (!r.has(key) || contains(sampling_keys_of(s.kind), key)) continue;
         if (kind_swept && sweep_keys.count(key)) {

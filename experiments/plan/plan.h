@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "brdfs/brdf.h"
+#include "brdfs/symmetry.h"
 #include "factor/size_choice.h"
 
 namespace bf {
@@ -83,12 +84,28 @@ struct BrdfVariant {
   nlohmann::json identity;  // everything that determines it (hashed into run ids)
 };
 
+// The orbit a run's fit uses when its samples stand for their symmetries
+// (experiments/run/symmetry_prep.h, docs/design.md §4.3): at most 2 staggered
+// rotations per sample (with swap and mirror, 8 copies of a Cornell sample), a
+// 2,000,000-sample budget. The stagger spreads the set over every azimuth
+// already; more rotations cost time and memory without lowering the errors.
+inline constexpr OrbitOptions kRunOrbit{2, 2'000'000};
+// The share of each measured sample's weight that stays on the sample itself;
+// its orbit copies share the rest. Without it the fit spends its capacity off
+// the measured slice and the held-out error rises (docs/design.md §4.3).
+inline constexpr double kRawShare = 0.5;
+// Both, as they enter a sampling's identity (run ids) when an orbit may be used.
+inline nlohmann::json orbit_identity() {
+  return {{"max_rotations", kRunOrbit.max_rotations}, {"budget", kRunOrbit.budget}, {"raw_share", kRawShare}};
+}
+
 struct SamplingVariant {
   std::string kind;         // "grid" | "stratified" | "file" | "measured"
   int resolution = 16;      // grid: res^4 parabolic grid
   uint64_t count = 0;       // stratified: pairs
   uint64_t seed = 1;        // stratified
   std::string path;         // file: sample-list CSV (resolved path)
+  std::string symmetries = "auto";  // "auto" | "off" | names joined by '+' (experiments/run/symmetry_prep.h)
   std::string label;        // "grid 16^4", "stratified 20000 seed 1", "file x.csv", "measured"
   std::string where;
   nlohmann::json identity;  // kind + parameters (+ file digest)

@@ -48,7 +48,7 @@ const std::vector<std::string>& result_columns() {
                           "search_strategy", "term_parameterizations", "negative_texels",
                           "order", "view_order", "tolerance", "tolerance_reached", "shade_rmse", "scene_rel_mse",
                           "val_rel_mse", "val_cos_rmse", "val_max_ratio", "holdout_rel_mse", "holdout_cos_rmse", "validation",
-                          "flag", "isotropic",
+                          "flag", "isotropic", "symmetries",
                           "refine", "refine_seconds", "rel_mse_before", "rel_mae_before", "rel_max_before",
                           "lin_rmse_before", "lin_mae_before", "lin_max_before", "cos_rmse_before", "model",
                           "sampler_storage", "sampler_build_s", "notes"})

@@ -54,6 +54,7 @@ HoldoutSplit split_holdout(const SampleSet& s, double fraction, uint64_t seed) {
   out.train.invalid_value = s.invalid_value;
   out.train.invalid_horizon = s.invalid_horizon;
   out.train.invalid_weight = s.invalid_weight;
+  out.train.symmetries = out.held.symmetries = s.symmetries;
   out.train.description = s.description + " without " + std::to_string(n_held) + " held-out samples";
   out.held.description = std::to_string(n_held) + " held-out samples of " + s.description;
   return out;

@@ -37,6 +37,11 @@
 #include "experiments/run/run_folder.h"
 #include "experiments/methods/method_kind.h"
 #include "experiments/report/validation.h"
+#include "experiments/run/symmetry_prep.h"
+#if __has_include("brdfs/measured.h")
+#include "brdfs/measured.h"
+#define BF_RUNNER_HAVE_MEASURED 1
+#endif
 #include "experiments/report/viewer.h"
 #include "solvers/cancel.h"
 #include "factor/isotropy.h"
@@ -143,7 +148,11 @@ MethodVariant with_tolerance_scorer(const MethodVariant& m, const Plan& plan, co
       return shade_rmse(*original, render_sphere(cand, scene));
     };
   } else {
-    if (!domain) throw std::runtime_error("tolerance " + metric + " needs a validation set (validation_pairs > 0)");
+    if (!domain)
+      throw std::runtime_error("tolerance " + metric +
+                               " needs a whole-domain validation set: validation_pairs > 0 and a BRDF that is a "
+                               "truth over the whole domain (an interpolant whose samples declare "
+                               "isotropic+reciprocal+bilateral; docs/design.md §4.3)");
     mv.tolerance->score = [domain, lt, metric](const Brdf& cand) {
       const ValidationScores v = score_validation(cand, domain.get(), nullptr, lt);
       return metric == "val_max_ratio" ? v.max_ratio : metric_value(v.val, metric.substr(4));
@@ -199,7 +208,16 @@ RunEntry execute_run(const Plan& plan, const PlannedRun& pr, const SampleSet& sa
   if (holds_out(plan.samplings[pr.sampling], plan.experiment))
     split = split_holdout(samples, plan.experiment.holdout, validation_seed(plan.experiment.seed));
   const SampleSet& fit_samples = split ? split->train : samples;
-  const auto domain = renders.validation(plan, pr.brdf);
+  // Symmetries (experiments/run/symmetry_prep.h): the fit sees each raw training
+  // sample's orbit; metrics and the held-out split stay on the raw samples.
+  const SymmetryChoice sym = choose_symmetries(plan.samplings[pr.sampling], samples);
+  OrbitInfo orbit;
+  const SampleSet fit_view = fit_set(fit_samples, sym, &orbit);
+  row["symmetries"] = sym.used.to_string();
+  rec["symmetries"] = {{"key", sym.key}, {"declared", sym.declared.to_string()}, {"used", sym.used.to_string()}};
+  if (sym.used.any()) rec["symmetries"]["orbit"] = orbit.describe();
+  std::string why_no_domain;
+  const auto domain = b.brdf->whole_domain(&why_no_domain) ? renders.validation(plan, pr.brdf) : nullptr;
   const LogTransform lt = LogTransform::of(fit_samples, plan.experiment.metric_eps);
   const MethodVariant m = with_tolerance_scorer(plan.methods[pr.method], plan, pr, renders, domain, lt);
 
@@ -208,12 +226,19 @@ RunEntry execute_run(const Plan& plan, const PlannedRun& pr, const SampleSet& sa
   row["isotropic"] = isotropy.isotropic ? "true" : "false";
   rec["isotropy"] = isotropy.describe();
 
+  // Kinds that tabulate the BRDF (svd, sh-k, sh-r) see a measured BRDF made of
+  // the training samples only, so their held-out columns are on unseen data.
+  BrdfVariant fit_b = b;
+#ifdef BF_RUNNER_HAVE_MEASURED
+  if (split && b.measured)
+    if (BrdfPtr t = measured_from_training(*b.brdf, split->train)) fit_b.brdf = std::move(t);
+#endif
   // Scene-weighted fits (experiments/report/scene_weights.h): the kind fits the
   // weighted samples; rel_mse and the other metrics stay unweighted.
   std::optional<SampleSet> weighted;
   if (const auto wf = m.options.find("weight_fit"); wf != m.options.end())
-    weighted = scene_weighted(fit_samples, scene_pairs(*b.brdf, plan.scene), wf->at("floor").get<double>());
-  const RunContext c{plan, pr, b, m, weighted ? *weighted : fit_samples, lt, isotropy, run_dir,
+    weighted = scene_weighted(fit_view, scene_pairs(*b.brdf, plan.scene), wf->at("floor").get<double>());
+  const RunContext c{plan, pr, fit_b, m, weighted ? *weighted : fit_view, lt, isotropy, run_dir,
                      [&] { return renders.get(plan, pr.brdf); }};
   const auto t0 = Clock::now();
   MethodOutcome out = kind.run(c);
@@ -232,8 +257,10 @@ RunEntry execute_run(const Plan& plan, const PlannedRun& pr, const SampleSet& sa
   {  // Validation on data the fit never saw, and its flags.
     const auto tv = Clock::now();
     const ValidationScores vs = score_validation(*out.result, domain.get(), split ? &split->held : nullptr, lt);
-    const std::string scheme = validation_scheme(plan, b, domain.get(), split ? &*split : nullptr,
-                                                 samples.valid_count());
+    std::string scheme = validation_scheme(plan, b, domain.get(), split ? &*split : nullptr,
+                                           samples.valid_count());
+    if (!domain && plan.experiment.validation_pairs > 0)
+      scheme = "no whole-domain columns: " + why_no_domain + (scheme.empty() ? "" : "; " + scheme);
     fill_validation_columns(vs, mt.rel_mse, scheme, row, notes);
     rec["validation"] = {{"scheme", scheme}, {"seconds", since(tv)}};
   }

@@ -103,6 +103,10 @@ float64 RGB in 1/sr ((3,) when both are (3,)). Directions of unit length
       .def_property_readonly("name", [](const PyBrdf& self) { return self.brdf->name(); })
       .def_property_readonly("reciprocal", [](const PyBrdf& self) { return self.brdf->reciprocal(); })
       .def_property_readonly("isotropic", [](const PyBrdf& self) { return self.brdf->isotropic(); })
+      .def_property_readonly("bilateral", [](const PyBrdf& self) { return self.brdf->bilateral(); })
+      .def_property_readonly("whole_domain", [](const PyBrdf& self) { return self.brdf->whole_domain(); },
+                             "Whether eval is the BRDF over the whole domain (an interpolant of scattered "
+                             "samples: only when its data declare isotropic+reciprocal+bilateral)")
       .def("to_string", [](const PyBrdf& self) { return self.brdf->to_string(); })
       .def("__repr__", [](const PyBrdf& self) { return "<brdf_factor.Brdf " + self.brdf->to_string() + ">"; });
 

@@ -55,7 +55,9 @@ void normalize_direction(Vec3& w) {
 }
 
 SamplesPtr from_arrays(const py::handle& wi_in, const py::handle& wo_in, const py::handle& value_in,
-                       const py::object& weight_in, const std::string& description) {
+                       const py::object& weight_in, const std::string& description,
+                       const std::string& symmetries) {
+  const Symmetries declared = parse_symmetries(symmetries, "SampleSet(symmetries=...)");
   auto wi = directions_array(wi_in, "wi");
   auto wo = directions_array(wo_in, "wo");
   auto value = directions_array(value_in, "value");
@@ -92,6 +94,7 @@ SamplesPtr from_arrays(const py::handle& wi_in, const py::handle& wo_in, const p
   }
   if (weight) s->weight.assign(weight->data(), weight->data() + n);
   s->description = description;
+  s->symmetries = declared;
   s->validate();
   return s;
 }
@@ -104,11 +107,13 @@ BRDF samples: direction pairs (wi, wo), RGB values in 1/sr, optional weights
 and a validity mask (invalid values, directions below the horizon and bad
 weights are masked, never used by fits and metrics).)doc")
       .def(py::init(&from_arrays), py::arg("wi"), py::arg("wo"), py::arg("value"), py::arg("weight") = py::none(),
-           py::arg("description") = "arrays",
-           R"doc(SampleSet(wi, wo, value, weight=None, description="arrays")
+           py::arg("description") = "arrays", py::arg("symmetries") = "none",
+           R"doc(SampleSet(wi, wo, value, weight=None, description="arrays", symmetries="none")
 
 wi, wo: (N, 3) directions (normalized here); value: (N, 3) RGB in 1/sr;
-weight: (N,) >= 0 or None (all 1). The arrays are copied once into the set.)doc")
+weight: (N,) >= 0 or None (all 1). The arrays are copied once into the set.
+symmetries: what the data guarantee of the BRDF they sample, "none" or names
+joined by '+' (isotropic, reciprocal, bilateral).)doc")
       .def("__len__", &SampleSet::size)
       .def_property_readonly("wi", [](const py::object& self) { return vec3_view(self, self.cast<const SampleSet&>().wi); },
                              "(N, 3) float64 view, read-only")
@@ -139,6 +144,8 @@ weight: (N,) >= 0 or None (all 1). The arrays are copied once into the set.)doc"
           "(N,) bool view: samples used by fits and metrics")
       .def_property_readonly("valid_count", &SampleSet::valid_count)
       .def_readonly("description", &SampleSet::description)
+      .def_property_readonly("symmetries", [](const SampleSet& s) { return s.symmetries.to_string(); },
+                             "What the data declare: \"none\" or names joined by '+' (isotropic, reciprocal, bilateral)")
       .def("summary", &SampleSet::summary)
       .def("compacted", [](const SampleSet& s) { return std::make_shared<SampleSet>(s.compacted()); },
            "A new set with only the valid samples.")

@@ -1,0 +1,41 @@
+// Symmetries as data preparation for a run (docs/design.md §4.3
+// "symmetries"): which symmetries the fit's samples stand for, and the
+// training set with each raw sample replaced by its orbit (brdfs/symmetry.h).
+// The fitters see an ordinary weighted SampleSet; training metrics and the
+// held-out split stay on the raw samples.
+#pragma once
+
+#include <string>
+
+#include "brdfs/sampleset.h"
+#include "brdfs/symmetry.h"
+#include "experiments/plan/plan.h"
+
+namespace bf {
+
+// The sampling key `symmetries` (experiments.md): "auto" (default): the
+// symmetries the samples declare, for raw samples (kinds measured and file)
+// only; grid and stratified sets already cover the domain and are left as
+// they are. "off" (or "none"): no expansion. Names joined by '+'
+// ("isotropic+reciprocal+bilateral"): the user declares these for the
+// samples (e.g. a CSV, which declares none) and the fit uses them, whatever
+// the kind.
+struct SymmetryChoice {
+  Symmetries declared;  // what the samples declare (after the key's declaration)
+  Symmetries used;      // what the orbit expansion uses
+  std::string key;      // the key's value
+};
+SymmetryChoice choose_symmetries(const SamplingVariant& s, const SampleSet& samples);
+
+// The orbit a run's fit uses (kRunOrbit) and the share of each measured
+// sample's weight that stays on the sample (kRawShare) are defined beside
+// SamplingVariant (experiments/plan/plan.h), where they enter the sampling's
+// identity, so a change to them changes the run ids and no cached run is reused.
+
+// The set the fit sees: `train` itself (a copy) when nothing is used, else
+// the valid training samples at kRawShare of their weight followed by
+// expand_orbit(train, used, kRunOrbit) at the rest. info describes the
+// expansion (samples_out counts both parts).
+SampleSet fit_set(const SampleSet& train, const SymmetryChoice& c, OrbitInfo* info);
+
+}  // namespace bf

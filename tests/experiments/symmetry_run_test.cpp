@@ -1,0 +1,127 @@
+// Symmetries in runs (experiments/run/symmetry_prep.h, docs/design.md §4.3):
+// whole-domain validation only against a truth that holds, the `symmetries`
+// column, and the `symmetries` sampling key.
+#include "brdfs/catalogue.h"
+#include "brdfs/sample_csv.h"
+#include "experiments/report/outputs.h"
+#include "experiments/run/symmetry_prep.h"
+#include "experiments_helpers.h"
+
+using namespace bf;
+using namespace bf_test;
+
+namespace {
+
+std::string config(const std::string& brdf_line, const std::string& sampling, const std::string& method) {
+  return "[experiment]\nseed = 3\nplots = false\nrender = false\nexport = false\nvalidation_pairs = 512\n"
+         "[[brdf]]\n" + brdf_line + "\n[sampling]\n" + sampling + "\n[[method]]\n" + method + "\n";
+}
+
+}  // namespace
+
+TEST_CASE("symmetry run: a planted anisotropic non-reciprocal CSV is never flagged") {
+  ScratchDir tmp;
+  // separable (defaults): a(wi) b(wo) c(h), neither isotropic nor reciprocal nor bilateral.
+  const BrdfPtr planted = Catalogue::builtin().make("separable");
+  REQUIRE_FALSE(planted->isotropic());
+  REQUIRE_FALSE(planted->reciprocal());
+  const std::string csv = tmp / "aniso.csv";
+  write_sample_csv(sample_stratified(*planted, 3000, 2), csv);
+  const std::string fit =
+      "kind = \"fit\"\ntexture_size = 8\nprojections = [{ name = \"wi\" }, { name = \"wo\" }, "
+      "{ name = \"h\", parameterization = \"halfdiff\" }]";
+
+  // Truth = the CSV's interpolant, which assumes symmetries the data do not declare:
+  // no whole-domain columns, the reason in `validation`, no flag.
+  run_quiet(write_text(tmp / "a.toml", config("file = \"" + csv + "\"", "kind = \"measured\"", fit)), tmp / "a");
+  const Row a = read_results_csv(tmp / "a/results.csv").at(0);
+  INFO("a: validation = " << a.at("validation") << ", flag = " << a.at("flag"));
+  CHECK(a.at("val_rel_mse").empty());
+  CHECK(a.at("val_max_ratio").empty());
+  CHECK(a.at("flag").empty());
+  CHECK(a.at("validation").find("no whole-domain columns") != std::string::npos);
+  CHECK(a.at("validation").find("declare none") != std::string::npos);
+  CHECK(!a.at("holdout_rel_mse").empty());
+  CHECK(a.at("symmetries") == "none");
+
+  // Truth = the analytic model, samples from the CSV: whole-domain columns against it, not flagged.
+  run_quiet(write_text(tmp / "b.toml", config("model = \"separable\"", "kind = \"file\"\npath = \"" + csv + "\"", fit)),
+            tmp / "b");
+  const Row b = read_results_csv(tmp / "b/results.csv").at(0);
+  INFO("b: validation = " << b.at("validation") << ", val_rel_mse = " << b.at("val_rel_mse") << ", holdout_rel_mse = " << b.at("holdout_rel_mse") << ", rel_mse = " << b.at("rel_mse"));
+  CHECK(!b.at("val_rel_mse").empty());
+  // The fit generalizes over the whole domain: its error there is at the held-out level.
+  CHECK(std::stod(b.at("val_rel_mse")) <= 2.0 * std::stod(b.at("holdout_rel_mse")));
+  CHECK(b.at("flag").empty());
+  CHECK(b.at("symmetries") == "none");
+}
+
+TEST_CASE("symmetry run: measured samples use their declared symmetries unless the key says off") {
+  ScratchDir tmp;
+  const std::string mccool = "kind = \"mccool\"\ntexture_size = 6";
+  run_quiet(write_text(tmp / "a.toml", config("model = \"krylon-blue\"", "kind = \"measured\"", mccool)), tmp / "a");
+  const Row a = read_results_csv(tmp / "a/results.csv").at(0);
+  CHECK(a.at("symmetries") == "isotropic+reciprocal+bilateral");
+  CHECK(!a.at("val_rel_mse").empty());
+  const std::string rec = read_text(tmp / ("a/runs/" + a.at("run_id") + "/run.json"));
+  CHECK(rec.find("orbit of 8 per sample (2 rotations x swap x mirror)") != std::string::npos);
+  run_quiet(write_text(tmp / "b.toml",
+                       config("model = \"krylon-blue\"", "kind = \"measured\"\nsymmetries = \"off\"", mccool)),
+            tmp / "b");
+  const Row b = read_results_csv(tmp / "b/results.csv").at(0);
+  CHECK(b.at("symmetries") == "none");
+  CHECK(a.at("run_id") != b.at("run_id"));
+  CHECK(a.at("samples") == b.at("samples"));  // training metrics stay on the raw samples
+  // Grid samples are left alone by default (analytic workloads do not change).
+  run_quiet(write_text(tmp / "c.toml", config("model = \"krylon-blue\"", "kind = \"grid\"\nresolution = 6", mccool)),
+            tmp / "c");
+  CHECK(read_results_csv(tmp / "c/results.csv").at(0).at("symmetries") == "none");
+}
+
+TEST_CASE("symmetry run: a bad symmetries value names the key and the accepted values") {
+  require_one_config_error("[experiment]\nname = \"t\"\n[[brdf]]\npreset = \"bluepaint\"\n[sampling]\nkind = "
+                           "\"grid\"\nresolution = 6\nsymmetries = \"isotropic+round\"\n[[method]]\nkind = \"mccool\"\n",
+                           {"sampling.symmetries", "isotropic+round", "bilateral"});
+}
+
+TEST_CASE("symmetry run: the fit set keeps each raw sample at its share and every sample's total weight") {
+  const BrdfPtr ct = Catalogue::builtin().make("cook-torrance");
+  SampleSet s = sample_stratified(*ct, 40, 3);
+  s.value[5] = Rgb::Constant(-1.0);  // masked: dropped from the fit set
+  s.validate();
+  const SymmetryChoice c{Symmetries::all(), Symmetries::all(), "auto"};
+  OrbitInfo info;
+  const SampleSet f = fit_set(s, c, &info);
+  REQUIRE(info.orbit_size == 8);
+  REQUIRE(f.size() == 39 + 39 * 8);
+  CHECK(info.samples_out == f.size());
+  double total = 0;
+  for (size_t k = 0; k < f.size(); ++k) total += f.weight_of(k);
+  CHECK(total == Approx(39.0).epsilon(1e-12));
+  // The raw samples come first, each at half its weight; its 8 orbit copies share the rest.
+  size_t j = 0;
+  for (size_t k = 0; k < s.size(); ++k) {
+    if (!s.valid[k]) continue;
+    CHECK(f.wi[j] == s.wi[k]);
+    CHECK(f.wo[j] == s.wo[k]);
+    CHECK(f.weight_of(j) == Approx(0.5));
+    ++j;
+  }
+  CHECK(f.weight_of(39) == Approx(0.5 / 8));
+}
+
+TEST_CASE("symmetry run: the orbit's settings are part of a raw sampling's identity") {
+  register_loaders();
+  const auto sampling_identity = [](const std::string& sampling) {
+    const Plan p = parse_plan(config("model = \"krylon-blue\"", sampling, "kind = \"mccool\"\ntexture_size = 4"),
+                              "cfg.toml", {});
+    return p.samplings.at(0).identity;
+  };
+  // A run cached under other orbit constants must not be reused: they are hashed.
+  const nlohmann::json on = sampling_identity("kind = \"measured\"");
+  REQUIRE(on.contains("orbit"));
+  CHECK(on.at("orbit") == orbit_identity());
+  CHECK(on.at("orbit").at("raw_share") == kRawShare);
+  CHECK_FALSE(sampling_identity("kind = \"measured\"\nsymmetries = \"off\"").contains("orbit"));
+  CHECK_FALSE(sampling_identity("kind = \"grid\"\nresolution = 4").contains("orbit"));
+}
