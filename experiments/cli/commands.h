@@ -16,5 +16,6 @@ void add_cmd_run(CLI::App& app);     // cmd_run.cpp
 void add_cmd_merge(CLI::App& app);   // cmd_merge.cpp
 void add_cmd_stress(CLI::App& app);  // cmd_stress.cpp
 void add_cmd_sample_dirs(CLI::App& app);  // cmd_sample_dirs.cpp
+void add_cmd_compare(CLI::App& app);  // cmd_compare.cpp
 
 }  // namespace bf

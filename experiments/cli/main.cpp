@@ -29,6 +29,7 @@ int main(int argc, char** argv) {
   bf::add_cmd_stress(app);
   bf::add_cmd_sample_dirs(app);
   bf::add_cmd_mc_variance(app);
+  bf::add_cmd_compare(app);
   try {
     bf::register_export_loader(bf::Catalogue::global());
     app.parse(argc, argv);
