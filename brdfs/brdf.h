@@ -46,6 +46,14 @@ class Brdf {
     (void)why;
     return true;
   }
+  // Whether eval(wi, wo) is backed by the BRDF's data. False only where a
+  // measured table has no value there (eval then returns its fill value, 0):
+  // a comparison against this BRDF as the truth skips such pairs.
+  virtual bool defined_at(const Vec3& wi, const Vec3& wo) const {
+    (void)wi;
+    (void)wo;
+    return true;
+  }
 };
 
 using BrdfPtr = std::shared_ptr<const Brdf>;

@@ -189,9 +189,17 @@ bool MeasuredBrdf::whole_domain(std::string* why) const {
   return false;
 }
 
-SampleSet measured_samples(const Brdf& brdf) {
-  if (const auto* m = dynamic_cast<const MeasuredBrdf*>(&brdf)) return m->samples();
-  if (const auto* m = dynamic_cast<const MerlBrdf*>(&brdf)) return m->samples(1);
+bool has_cell_measure(const Brdf& brdf) { return dynamic_cast<const MerlBrdf*>(&brdf) != nullptr; }
+
+SampleSet measured_samples(const Brdf& brdf, bool measure_weights) {
+  if (const auto* m = dynamic_cast<const MeasuredBrdf*>(&brdf)) {
+    if (measure_weights)
+      throw std::invalid_argument(brdf.to_string() +
+                                  ": weights = \"measure\" needs a table whose cells have a known measure (a MERL "
+                                  ".binary); expected weights = \"none\" or \"auto\" for scattered samples");
+    return m->samples();
+  }
+  if (const auto* m = dynamic_cast<const MerlBrdf*>(&brdf)) return m->samples(1, measure_weights);
   throw std::invalid_argument(brdf.to_string() +
                               ": not a measured BRDF (expected one loaded from .astm, .brdf, "
                               ".csv or .binary); sample it with a grid or stratified set instead");

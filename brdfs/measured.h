@@ -131,9 +131,13 @@ class MeasuredBrdf final : public Brdf {
 };
 
 // The samples a measured BRDF is made of: MeasuredBrdf -> its raw list,
-// MerlBrdf -> one sample per table cell (missing cells masked). Throws
-// std::invalid_argument for any other BRDF, naming it.
-SampleSet measured_samples(const Brdf& brdf);
+// MerlBrdf -> one sample per table cell (missing cells masked), weighted by
+// each cell's measure when measure_weights (MerlBrdf::samples). Throws
+// std::invalid_argument for any other BRDF, naming it, and for
+// measure_weights on scattered samples (their measure is not known).
+SampleSet measured_samples(const Brdf& brdf, bool measure_weights = false);
+// Whether measured_samples can weight this BRDF's samples by measure (a MERL table).
+bool has_cell_measure(const Brdf& brdf);
 
 // The measured BRDF made of `train` only (the samples a fit may see, e.g. the
 // training part of a held-out split): MeasuredBrdf -> the interpolant of

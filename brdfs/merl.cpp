@@ -273,12 +273,22 @@ MerlBrdf::MerlBrdf(std::shared_ptr<const MerlTable> table, MerlLookup lookup, st
 
 Rgb MerlBrdf::eval(const Vec3& wi, const Vec3& wo) const {
   if (wi.z() <= 0.0 || wo.z() <= 0.0) return Rgb::Zero();
+  return lookup_value(wi, wo).value_or(Rgb::Zero());
+}
+
+bool MerlBrdf::defined_at(const Vec3& wi, const Vec3& wo) const {
+  if (wi.z() <= 0.0 || wo.z() <= 0.0) return true;  // 0 below the horizon is the BRDF's value
+  return lookup_value(wi, wo).has_value();
+}
+
+std::optional<Rgb> MerlBrdf::lookup_value(const Vec3& wi, const Vec3& wo) const {
   const MerlAngles a = merl_half_diff(wi, wo);
   const MerlTable& t = *table_;
   if (lookup_ == MerlLookup::Nearest) {
     const size_t cell = merl_cell(merl_theta_h_index(a.theta_h), merl_theta_d_index(a.theta_d),
                                   merl_phi_d_index(a.phi_d));
-    return t.missing(cell) ? Rgb::Zero() : t.value(cell);
+    if (t.missing(cell)) return std::nullopt;
+    return t.value(cell);
   }
   // Continuous index coordinates; bin centres sit at integers.
   const double u = std::clamp(kMerlThetaH * std::sqrt(std::max(a.theta_h, 0.0) / (M_PI / 2)) - 0.5,
@@ -303,8 +313,8 @@ Rgb MerlBrdf::eval(const Vec3& wi, const Vec3& wo) const {
         sum += wt * t.value(cell);
         wsum += wt;
       }
-  if (!(wsum > 1e-12)) return Rgb::Zero();
-  return sum / wsum;
+  if (!(wsum > 1e-12)) return std::nullopt;
+  return Rgb(sum / wsum);
 }
 
 std::string MerlBrdf::to_string() const {
@@ -312,7 +322,16 @@ std::string MerlBrdf::to_string() const {
          ")";
 }
 
-SampleSet MerlBrdf::samples(int stride) const {
+double merl_cell_measure(int h, int d, int nh, int nd, int np) {
+  const double lo = double(h) / kMerlThetaH, hi = double(std::min(h + nh, kMerlThetaH)) / kMerlThetaH;
+  const double dtheta_h = (hi * hi - lo * lo) * (M_PI / 2);  // theta_h = (index / 90)^2 pi / 2
+  const double dtheta_d = double(std::min(d + nd, kMerlThetaD) - d) * (M_PI / 2) / kMerlThetaD;
+  const double dphi_d = double(np) * M_PI / kMerlPhiD;
+  const double th = merl_theta_h_centre(h), td = merl_theta_d_centre(d);
+  return std::sin(th) * dtheta_h * std::sin(td) * std::cos(td) * dtheta_d * dphi_d;
+}
+
+SampleSet MerlBrdf::samples(int stride, bool measure_weights) const {
   if (stride < 1 || stride > kMerlThetaH)
     throw std::invalid_argument("merl samples: stride expected 1..90, found " +
                                 std::to_string(stride));
@@ -331,9 +350,23 @@ SampleSet MerlBrdf::samples(int stride) const {
         Vec3 wi, wo;
         merl_half_diff_inverse(
             {merl_theta_h_centre(h), merl_theta_d_centre(d), merl_phi_d_centre(p)}, wi, wo);
-        s.push(wi, wo, t.missing(cell) ? Rgb::Constant(-1.0) : t.value(cell));
+        s.push(wi, wo, t.missing(cell) ? Rgb::Constant(-1.0) : t.value(cell),
+               measure_weights ? merl_cell_measure(h, d, stride, stride, stride) : 1.0);
       }
   s.description = "merl table " + source_ + " (bin centres, stride " + std::to_string(stride) + ")";
+  if (measure_weights) {
+    // Mean 1 over the samples a fit uses, so the smoothing keeps its balance.
+    double sum = 0.0;
+    size_t n = 0;
+    for (size_t k = 0; k < s.size(); ++k)
+      if ((s.value[k] >= 0.0).all()) {
+        sum += s.weight[k];
+        ++n;
+      }
+    if (sum > 0.0)
+      for (double& w : s.weight) w *= double(n) / sum;
+    s.description += ", weighted by cell measure";
+  }
   // The format stores an isotropic, reciprocal BRDF (phi_h dropped, phi_d folded
   // by reciprocity); it does not assume the mirror phi_d -> -phi_d.
   s.symmetries = {true, true, false};

@@ -24,6 +24,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -110,6 +111,13 @@ enum class MerlLookup {
 // "nearest" | "linear"; throws std::invalid_argument naming the accepted values.
 MerlLookup parse_merl_lookup(const std::string& s, const std::string& what);
 
+// The measure d(wi) d(wo) of the pairs whose (theta_h, theta_d, phi_d) lie in
+// the cells [h, h + nh) x [d, d + nd) x [p, p + np), up to a constant factor,
+// at the first cell's centre: with dwi dwo = 4 cos(theta_d) dw_h dw_d,
+// sin(theta_h) dtheta_h sin(theta_d) cos(theta_d) dtheta_d dphi_d, where the
+// theta_h bins are uniform in sqrt(theta_h).
+double merl_cell_measure(int h, int d, int nh = 1, int nd = 1, int np = 1);
+
 // A BRDF given by a MERL table (shared, so copies are cheap).
 //
 // eval: 0 below the horizon. Nearest: the cell's value, 0 if the cell is
@@ -125,17 +133,25 @@ class MerlBrdf final : public Brdf {
   Rgb eval(const Vec3& wi, const Vec3& wo) const override;
   std::string name() const override { return "merl"; }
   std::string to_string() const override;
+  // False where eval has no table value to return (the nearest cell missing;
+  // linear: all 8 corners missing) and eval returns 0 as a fill.
+  bool defined_at(const Vec3& wi, const Vec3& wo) const override;
 
   // One sample per stride-th cell in each of the three dimensions, at bin
   // centres (phi_h = 0); missing cells get value -1 and are masked (invalid),
   // so no fit ever uses them. stride 1 gives all 1,458,000 cells. Throws
-  // std::invalid_argument for stride outside 1..90.
-  SampleSet samples(int stride = 1) const;
+  // std::invalid_argument for stride outside 1..90. measure_weights: each
+  // sample weighted by the measure of the cells it stands for in the
+  // hemisphere-pair space (merl_cell_measure), normalized to mean 1 over the
+  // valid samples; else unweighted.
+  SampleSet samples(int stride = 1, bool measure_weights = false) const;
   const MerlTable& table() const { return *table_; }
   MerlLookup lookup() const { return lookup_; }
   const std::string& source() const { return source_; }
 
  private:
+  // eval's value, or nullopt where the table has none (above the horizon).
+  std::optional<Rgb> lookup_value(const Vec3& wi, const Vec3& wo) const;
   std::shared_ptr<const MerlTable> table_;
   MerlLookup lookup_;
   std::string source_;

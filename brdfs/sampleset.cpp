@@ -83,6 +83,17 @@ void evaluate_into(const Brdf& brdf, SampleSet& s) {
   s.validate();
 }
 
+size_t mask_undefined(const Brdf& truth, SampleSet& s) {
+  size_t n = 0;
+  for (size_t k = 0; k < s.size(); ++k)
+    if (s.valid[k] && !truth.defined_at(s.wi[k], s.wo[k])) {
+      s.value[k] = Rgb::Constant(-1.0);
+      ++n;
+    }
+  if (n > 0) s.validate();
+  return n;
+}
+
 SampleSet sample_grid(const Brdf& brdf, int res) {
   if (res < 2 || res > kMaxSampleGridResolution)
     throw std::invalid_argument("grid resolution: expected 2.." + std::to_string(kMaxSampleGridResolution) +

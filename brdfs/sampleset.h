@@ -62,5 +62,10 @@ SampleSet sample_stratified(const Brdf& brdf, size_t count, uint64_t seed);
 
 // Evaluates brdf at the given direction pairs (values of an existing set are replaced).
 void evaluate_into(const Brdf& brdf, SampleSet& s);
+// Masks (value -1, invalid) every valid sample of s at which `truth` has no
+// data (Brdf::defined_at false: e.g. a MERL table's missing cells) and returns
+// how many it masked. A set of truth values scored against is then scored
+// only where the truth holds.
+size_t mask_undefined(const Brdf& truth, SampleSet& s);
 
 }  // namespace bf

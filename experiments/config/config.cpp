@@ -50,7 +50,7 @@ const std::map<std::string, std::vector<std::string>>& key_table() {
       {"top", {"experiment", "brdf", "sampling", "method", "scene"}},
       {"experiment", {"name", "seed", "out", "description", "jobs", "plots", "render", "export",
                       "metric_eps", "validation_pairs", "holdout"}},
-      {"sampling", {"kind", "resolution", "count", "seed", "path", "zip", "symmetries"}},
+      {"sampling", {"kind", "resolution", "count", "seed", "path", "zip", "symmetries", "weights"}},
       {"scene", {"shade_rmse", "light", "intensity", "size", "environment", "environment_eps", "lighting_order",
                  "lighting_nodes"}},
       {"brdf", {"preset", "model", "file", "name", "zip"}},
@@ -384,6 +384,18 @@ void read_samplings(const toml::node* node, Ctx& ctx, uint64_t base_seed,
         if (s.symmetries != "off" && s.symmetries != "none") s.identity["orbit"] = orbit_identity();
       }
       if (s.symmetries != "auto") s.label += " symmetries " + s.symmetries;
+      // Sample weights of measured data (brdfs/measured.h): "auto" weights a MERL
+      // table's cells by their measure, leaves scattered samples unweighted. In
+      // the identity of every measured set (its results depend on it).
+      if (r.has("weights") && s.kind != "measured") {
+        r.fail("weights", "applies to kind = \"measured\" only (a table's cell weights), found kind = \"" +
+                              s.kind + "\"");
+        r.take("weights");
+      } else if (s.kind == "measured") {
+        s.weights = r.choice("weights", "auto", {"auto", "measure", "none"});
+        s.identity["weights"] = s.weights;
+        if (s.weights != "auto") s.label += " weights " + s.weights;
+      }
       for (const auto& key : {"resolution", "count", "seed", "path"}) {
         if (!r.has(key) || contains(sampling_keys_of(s.kind), key)) continue;
         if (kind_swept && sweep_keys.count(key)) {

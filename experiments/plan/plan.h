@@ -106,6 +106,9 @@ struct SamplingVariant {
   uint64_t seed = 1;        // stratified
   std::string path;         // file: sample-list CSV (resolved path)
   std::string symmetries = "auto";  // "auto" | "off" | names joined by '+' (experiments/run/symmetry_prep.h)
+  // measured: "auto" (= "measure" for a MERL table, "none" otherwise) | "measure"
+  // (each table cell weighted by the hemisphere-pair measure it stands for) | "none".
+  std::string weights = "auto";
   std::string label;        // "grid 16^4", "stratified 20000 seed 1", "file x.csv", "measured"
   std::string where;
   nlohmann::json identity;  // kind + parameters (+ file digest)

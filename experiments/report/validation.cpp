@@ -63,6 +63,8 @@ HoldoutSplit split_holdout(const SampleSet& s, double fraction, uint64_t seed) {
 SampleSet validation_set(const Brdf& brdf, int pairs, uint64_t seed) {
   SampleSet v = sample_stratified(brdf, static_cast<size_t>(pairs), seed);
   v.description = "validation: stratified " + std::to_string(pairs) + " pairs over the hemisphere pair";
+  if (const size_t skipped = mask_undefined(brdf, v); skipped > 0)
+    v.description += " (" + std::to_string(skipped) + " where the truth has no data skipped)";
   return v;
 }
 

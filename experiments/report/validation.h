@@ -46,6 +46,9 @@ HoldoutSplit split_holdout(const SampleSet& s, double fraction, uint64_t seed);
 // The whole-domain validation set of a BRDF: sample_stratified(brdf, pairs,
 // seed) (Latin-hypercube in cos theta and phi of both directions, uniform in
 // solid angle, so grazing directions are sampled as often as their solid angle).
+// Pairs where brdf has no data (Brdf::defined_at: a MERL table's missing
+// cells) are masked, and the description counts them: the whole-domain
+// columns compare only where the truth holds.
 SampleSet validation_set(const Brdf& brdf, int pairs, uint64_t seed);
 
 // Scores of one approximation on the validation data.

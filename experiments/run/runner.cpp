@@ -125,7 +125,11 @@ std::string validation_scheme(const Plan& plan, const BrdfVariant& b, const Samp
   if (domain)
     parts.push_back("domain: " + std::to_string(domain->size()) + " stratified pairs (seed " +
                     std::to_string(validation_seed(plan.experiment.seed)) + ") vs the " +
-                    (b.measured ? "interpolant" : "BRDF"));
+                    (b.measured ? "interpolant" : "BRDF") +
+                    (domain->valid_count() < domain->size()
+                         ? " (" + std::to_string(domain->size() - domain->valid_count()) +
+                               " where it has no data skipped)"
+                         : std::string()));
   if (split)
     parts.push_back("held out: " + std::to_string(split->held.valid_count()) + " of " + std::to_string(all_valid) +
                     " samples (" + format_number(plan.experiment.holdout * 100.0) + "%), not fitted");

@@ -172,7 +172,13 @@ std::shared_ptr<const SampleSet> make_samples(const Plan& plan, const PlannedRun
   }
   if (s.kind == "measured") {
 #ifdef BF_HAVE_MEASURED
-    *out = measured_samples(*b.brdf);
+    // weights (config): "auto" = a MERL table's cells by their measure.
+    const bool measure = s.weights == "measure" || (s.weights == "auto" && has_cell_measure(*b.brdf));
+    try {
+      *out = measured_samples(*b.brdf, measure);
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(s.where + ": sampling.weights: " + e.what());
+    }
     return out;
 #else
     throw std::invalid_argument("sampling: measured samples are not available in this build");

@@ -254,6 +254,34 @@ TEST_CASE("merl: missing cells give 0, are renormalized away, and are masked in 
   CHECK((linear.eval(Vec3(0, 0, 1), Vec3(0.6, 0, -0.8)) == 0.0).all());
 }
 
+TEST_CASE("merl: defined_at is false exactly where eval has no table value to return") {
+  auto t = std::make_shared<MerlTable>(merl_tabulate(Lambert(LambertParams{})));
+  const int h = 30, d = 30, p = 60;
+  t->raw[merl_cell(h, d, p)] = -1.0;
+  const MerlBrdf nearest(t, MerlLookup::Nearest, "hole");
+  const MerlBrdf linear(t, MerlLookup::Linear, "hole");
+  Vec3 wi, wo;
+  merl_half_diff_inverse({merl_theta_h_centre(h), merl_theta_d_centre(d), merl_phi_d_centre(p)}, wi, wo);
+  CHECK_FALSE(nearest.defined_at(wi, wo));
+  merl_half_diff_inverse(
+      {merl_theta_h_centre(h) + 1e-4, merl_theta_d_centre(d) + 1e-3, merl_phi_d_centre(p) + 1e-3}, wi, wo);
+  CHECK(linear.defined_at(wi, wo));  // its 7 other corners hold values
+  merl_half_diff_inverse({merl_theta_h_centre(h), merl_theta_d_centre(d), merl_phi_d_centre(p + 1)}, wi, wo);
+  CHECK(nearest.defined_at(wi, wo));
+  // All 8 corners of a linear lookup missing: no value.
+  for (int dh = 0; dh < 2; ++dh)
+    for (int dd = 0; dd < 2; ++dd)
+      for (int dp = 0; dp < 2; ++dp) t->raw[merl_cell(h + dh, d + dd, p + dp)] = -1.0;
+  merl_half_diff_inverse(
+      {0.5 * (merl_theta_h_centre(h) + merl_theta_h_centre(h + 1)), merl_theta_d_centre(d) + 0.004,
+       merl_phi_d_centre(p) + 0.008},
+      wi, wo);
+  CHECK_FALSE(linear.defined_at(wi, wo));
+  CHECK((linear.eval(wi, wo) == 0.0).all());
+  // Below the horizon the BRDF is 0 by definition: defined.
+  CHECK(linear.defined_at(Vec3(0, 0, 1), Vec3(0.6, 0, -0.8)));
+}
+
 TEST_CASE("merl: corrupt files are rejected with expected and found") {
   TempDir d("merl_bad");
   const size_t n = 3 * kMerlCells;
@@ -387,4 +415,33 @@ TEST_CASE("cli: export-merl writes a readable 34,992,012-byte file, atomically")
   CHECK(entries == 1);  // no temporary left beside it
   CHECK(run_cli("export-merl --brdf lambert --out " + d.file("no/such/dir/x.binary"), &err) == 2);
   CHECK_THAT(err, Contains("cannot open"));
+}
+
+TEST_CASE("merl: cell measure weights make cell averages uniform averages over the hemisphere pair") {
+  // Over pairs uniform in solid angle, E[cos theta_o] = 1/2 and E[cos theta_i cos theta_o] = 1/4.
+  auto t = std::make_shared<MerlTable>(merl_tabulate(Lambert(LambertParams{})));
+  const MerlBrdf table(t, MerlLookup::Nearest, "lambert");
+  const SampleSet w = table.samples(1, true);
+  const SampleSet u = table.samples(1, false);
+  REQUIRE(w.weight.size() == w.size());
+  CHECK(u.weight.empty());
+  CHECK_THAT(w.description, Contains("weighted by cell measure"));
+  double sw = 0, m1 = 0, m2 = 0, su = 0, u1 = 0;
+  for (size_t k = 0; k < w.size(); ++k) {
+    if (!w.valid[k]) continue;
+    sw += w.weight[k];
+    m1 += w.weight[k] * w.wo[k].z();
+    m2 += w.weight[k] * w.wi[k].z() * w.wo[k].z();
+    su += 1;
+    u1 += u.wo[k].z();
+  }
+  CHECK(sw / su == Approx(1.0).epsilon(1e-12));  // normalized to mean 1 over the valid cells
+  CHECK(m1 / sw == Approx(0.5).margin(0.01));
+  CHECK(m2 / sw == Approx(0.25).margin(0.01));
+  CHECK(std::abs(u1 / su - 0.5) > 0.03);  // unweighted cells are not uniform in the pair measure
+  // The closed form of one cell: sin(theta_h) dtheta_h sin(theta_d) cos(theta_d) dtheta_d dphi_d.
+  const double th = merl_theta_h_centre(10), td = merl_theta_d_centre(20);
+  const double dth = (std::pow(11.0 / 90, 2) - std::pow(10.0 / 90, 2)) * M_PI / 2;
+  CHECK(merl_cell_measure(10, 20) ==
+        Approx(std::sin(th) * dth * std::sin(td) * std::cos(td) * (M_PI / 180) * (M_PI / 180)).epsilon(1e-12));
 }

@@ -125,3 +125,32 @@ TEST_CASE("symmetry run: the orbit's settings are part of a raw sampling's ident
   CHECK_FALSE(sampling_identity("kind = \"measured\"\nsymmetries = \"off\"").contains("orbit"));
   CHECK_FALSE(sampling_identity("kind = \"grid\"\nresolution = 4").contains("orbit"));
 }
+
+TEST_CASE("sample weights: the weights key applies to measured sets only and is part of their identity") {
+  register_loaders();
+  require_one_config_error("[experiment]\nname = \"t\"\n[[brdf]]\npreset = \"bluepaint\"\n[sampling]\nkind = "
+                           "\"grid\"\nresolution = 6\nweights = \"measure\"\n[[method]]\nkind = \"mccool\"\n",
+                           {"sampling.weights", "measured", "grid"});
+  require_one_config_error("[experiment]\nname = \"t\"\n[[brdf]]\nmodel = \"krylon-blue\"\n[sampling]\nkind = "
+                           "\"measured\"\nweights = \"solid\"\n[[method]]\nkind = \"mccool\"\n",
+                           {"sampling.weights", "solid", "measure"});
+  const auto identity = [](const std::string& sampling) {
+    return parse_plan(config("model = \"krylon-blue\"", sampling, "kind = \"mccool\"\ntexture_size = 4"), "cfg.toml",
+                      {})
+        .samplings.at(0)
+        .identity;
+  };
+  CHECK(identity("kind = \"measured\"").at("weights") == "auto");
+  CHECK(identity("kind = \"measured\"\nweights = \"none\"").at("weights") == "none");
+  CHECK_FALSE(identity("kind = \"grid\"\nresolution = 4").contains("weights"));
+}
+
+TEST_CASE("sample weights: measure weights on scattered samples are refused naming the key") {
+  ScratchDir tmp;
+  std::string out;
+  const std::string cfg = write_text(
+      tmp / "w.toml", config("model = \"krylon-blue\"", "kind = \"measured\"\nweights = \"measure\"",
+                             "kind = \"mccool\"\ntexture_size = 4"));
+  CHECK(run_cli("run " + cfg + " --out " + (tmp / "o") + " --no-plots", &out) != 0);
+  CHECK_THAT(out, Catch::Contains("sampling.weights") && Catch::Contains("MERL"));
+}

@@ -5,6 +5,8 @@
 #include <cmath>
 
 #include "brdfs/catalogue.h"
+#include "brdfs/merl.h"
+#include "brdfs/models.h"
 #include "brdfs/sample_csv.h"
 #include "experiments/config/config.h"
 #include "experiments/report/validation.h"
@@ -281,4 +283,27 @@ TEST_CASE("validation: tolerances on external metrics need their source") {
   CHECK_THROWS_WITH(parse_plan(val, "cfg.toml", {"experiment.validation_pairs=0"}),
                     Catch::Contains("validation_pairs = 0"));
   CHECK_NOTHROW(parse_plan(val, "cfg.toml"));
+}
+
+TEST_CASE("validation: pairs where a measured truth has no data are skipped and counted") {
+  // A MERL table of a Lambertian with every theta_d >= 60 deg cell missing.
+  auto t = std::make_shared<MerlTable>(merl_tabulate(Lambert(LambertParams{})));
+  for (int h = 0; h < kMerlThetaH; ++h)
+    for (int d = 60; d < kMerlThetaD; ++d)
+      for (int p = 0; p < kMerlPhiD; ++p) t->raw[merl_cell(h, d, p)] = -1.0;
+  const MerlBrdf truth(t, MerlLookup::Nearest, "holes");
+  const SampleSet dom = validation_set(truth, 1024, 3);
+  const size_t skipped = dom.size() - dom.valid_count();
+  CHECK(skipped > 50);  // pairs with theta_d >= 60 deg: a sizeable share of the hemisphere pair
+  CHECK(skipped < dom.size() / 2);
+  CHECK_THAT(dom.description, Catch::Contains(std::to_string(skipped) + " where the truth has no data skipped"));
+  // The Lambertian it was tabulated from matches the truth wherever the truth has data.
+  const Lambert lambert{LambertParams{}};
+  const ValidationScores v = score_validation(lambert, &dom, nullptr, LogTransform::of(dom));
+  CHECK(v.val.rel_mse < 1e-20);
+  CHECK(v.val.samples == dom.valid_count());
+  // A truth with data everywhere skips nothing.
+  const SampleSet full = validation_set(lambert, 1024, 3);
+  CHECK(full.valid_count() == full.size());
+  CHECK_THAT(full.description, !Catch::Contains("skipped"));
 }
