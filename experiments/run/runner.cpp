@@ -14,11 +14,13 @@
 #include <new>
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <condition_variable>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
+#include <limits>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -38,6 +40,7 @@
 #include "experiments/methods/method_kind.h"
 #include "experiments/report/validation.h"
 #include "experiments/run/symmetry_prep.h"
+#include "experiments/run/folds.h"
 #if __has_include("brdfs/measured.h")
 #include "brdfs/measured.h"
 #define BF_RUNNER_HAVE_MEASURED 1
@@ -120,7 +123,7 @@ class RenderCache {
 
 // The validation scheme of a run, in words (the `validation` column).
 std::string validation_scheme(const Plan& plan, const BrdfVariant& b, const SampleSet* domain,
-                              const HoldoutSplit* split, size_t all_valid) {
+                              const HoldoutSplit* split, const FoldSummary* folds, size_t all_valid) {
   std::vector<std::string> parts;
   if (domain)
     parts.push_back("domain: " + std::to_string(domain->size()) + " stratified pairs (seed " +
@@ -129,6 +132,11 @@ std::string validation_scheme(const Plan& plan, const BrdfVariant& b, const Samp
   if (split)
     parts.push_back("held out: " + std::to_string(split->held.valid_count()) + " of " + std::to_string(all_valid) +
                     " samples (" + format_number(plan.experiment.holdout * 100.0) + "%), not fitted");
+  if (folds)
+    parts.push_back("held out: " + std::to_string(folds->folds) + "-fold (seed " +
+                    std::to_string(validation_seed(plan.experiment.seed)) + "), each of " +
+                    std::to_string(all_valid) + " samples held out once; holdout_* are the mean over the folds (" +
+                    folds->spread() + "); the scored fit uses every sample");
   return join(parts, "; ");
 }
 
@@ -204,8 +212,15 @@ RunEntry execute_run(const Plan& plan, const PlannedRun& pr, const SampleSet& sa
   json rec = run_record(plan, pr, samples);
   // Validation data (experiments/report/validation.h): raw samples lose a held-out
   // fraction before the fit; the whole-domain set is shared by the BRDF's runs.
+  // With experiment.folds (experiments/run/folds.h) nothing is held out of the
+  // run's own fit: the folds are fitted separately below.
+  const bool raw = holds_out(plan.samplings[pr.sampling], plan.experiment) ||
+                   (plan.experiment.folds >= 2 && holds_out(plan.samplings[pr.sampling], ExperimentSettings{}));
+  const bool use_folds = raw && plan.experiment.folds >= 2;
+  std::vector<HoldoutSplit> folds;
+  if (use_folds) folds = split_folds(samples, plan.experiment.folds, validation_seed(plan.experiment.seed));
   std::optional<HoldoutSplit> split;
-  if (holds_out(plan.samplings[pr.sampling], plan.experiment))
+  if (raw && !use_folds)
     split = split_holdout(samples, plan.experiment.holdout, validation_seed(plan.experiment.seed));
   const SampleSet& fit_samples = split ? split->train : samples;
   // Symmetries (experiments/run/symmetry_prep.h): the fit sees each raw training
@@ -219,12 +234,90 @@ RunEntry execute_run(const Plan& plan, const PlannedRun& pr, const SampleSet& sa
   std::string why_no_domain;
   const auto domain = b.brdf->whole_domain(&why_no_domain) ? renders.validation(plan, pr.brdf) : nullptr;
   const LogTransform lt = LogTransform::of(fit_samples, plan.experiment.metric_eps);
-  const MethodVariant m = with_tolerance_scorer(plan.methods[pr.method], plan, pr, renders, domain, lt);
+  MethodVariant m = with_tolerance_scorer(plan.methods[pr.method], plan, pr, renders, domain, lt);
 
   // Azimuthal-invariance test of the BRDF (factor/isotropy.h): results column `isotropic`.
   const IsotropyResult isotropy = test_isotropy(*b.brdf);
   row["isotropic"] = isotropy.isotropic ? "true" : "false";
   rec["isotropy"] = isotropy.describe();
+
+  // One fit of the method without the held-out samples h.held (the same
+  // preparation as the run's own fit: symmetries, the training-only BRDF of
+  // the tabulating kinds, scene weights), scored on them.
+  auto held_out_score = [&](const HoldoutSplit& h, const MethodVariant& mv) {
+    const SampleSet view = fit_set(h.train, sym, nullptr);
+    const LogTransform flt = LogTransform::of(h.train, plan.experiment.metric_eps);
+    BrdfVariant fb = b;
+#ifdef BF_RUNNER_HAVE_MEASURED
+    if (b.measured)
+      if (BrdfPtr t = measured_from_training(*b.brdf, h.train)) fb.brdf = std::move(t);
+#endif
+    std::optional<SampleSet> wv;
+    if (const auto wf = mv.options.find("weight_fit"); wf != mv.options.end())
+      wv = scene_weighted(view, scene_pairs(*b.brdf, plan.scene), wf->at("floor").get<double>());
+    const RunContext fc{plan, pr, fb, mv, wv ? *wv : view, flt, isotropy, run_dir,
+                        [&] { return renders.get(plan, pr.brdf); }};
+    const MethodOutcome fo = kind.run(fc);
+    if (!fo.result) throw std::runtime_error("method " + mv.kind + " returned no factorization");
+    return evaluate_metrics(*fo.result, h.held, flt);
+  };
+  // A key chosen by held-out error (MethodVariant::cv): each candidate fitted
+  // without the held-out samples (every fold, or the single fraction), the
+  // lowest mean held-out rel_mse chosen; the run's fit then uses the choice.
+  std::vector<Metrics> chosen_folds;
+  std::string cv_note;
+  if (m.cv) {
+    if (!raw || (!use_folds && !split))
+      throw std::invalid_argument(m.cv->key + " = \"cv\" needs held-out samples (raw samples with holdout or folds)");
+    const auto tc = Clock::now();
+    json cands = json::array();
+    std::vector<std::string> words;
+    size_t best = 0;
+    double best_err = std::numeric_limits<double>::infinity();
+    std::vector<std::vector<Metrics>> per_candidate;
+    for (size_t i = 0; i < m.cv->ladder.size(); ++i) {
+      MethodVariant mv = m;
+      m.cv->apply(mv, m.cv->ladder[i]);
+      std::vector<Metrics> sc;
+      if (use_folds)
+        for (const HoldoutSplit& h : folds) sc.push_back(held_out_score(h, mv));
+      else
+        sc.push_back(held_out_score(*split, mv));
+      const FoldSummary fs = summarize_folds(sc);
+      cands.push_back({{"value", m.cv->ladder[i]},
+                       {"holdout_rel_mse", fs.rel_mse_mean},
+                       {"holdout_cos_rmse", fs.cos_rmse_mean}});
+      words.push_back(format_short(format_number(m.cv->ladder[i])) + ": " +
+                      format_short(format_number(fs.rel_mse_mean)));
+      if (std::isfinite(fs.rel_mse_mean) && fs.rel_mse_mean < best_err) best_err = fs.rel_mse_mean, best = i;
+      per_candidate.push_back(std::move(sc));
+    }
+    const double chosen = m.cv->ladder[best];
+    const std::string by = use_folds ? std::to_string(plan.experiment.folds) + "-fold mean held-out rel_mse"
+                                     : "held-out rel_mse of the held-out fraction";
+    m.cv->apply(m, chosen);
+    if (use_folds) chosen_folds = per_candidate[best];
+    rec["cv"] = {{"key", m.cv->key}, {"by", by}, {"candidates", cands}, {"chosen", chosen},
+                 {"seconds", since(tc)}};
+    cv_note = m.cv->key + " = \"cv\" chose " + format_short(format_number(chosen)) + " by " + by + " (" +
+              join(words, ", ") + ")";
+  }
+  std::optional<FoldSummary> fold_summary;
+  if (use_folds) {
+    const auto tf = Clock::now();
+    std::vector<Metrics> per_fold;
+    json fr = json::array();
+    for (size_t f = 0; f < folds.size(); ++f) {
+      const HoldoutSplit& h = folds[f];
+      per_fold.push_back(chosen_folds.empty() ? held_out_score(h, m) : chosen_folds[f]);
+      fr.push_back({{"train", h.train.valid_count()},
+                    {"held", h.held.valid_count()},
+                    {"holdout_rel_mse", per_fold.back().rel_mse},
+                    {"holdout_cos_rmse", per_fold.back().cos_rmse}});
+    }
+    fold_summary = summarize_folds(per_fold);
+    rec["folds"] = {{"k", plan.experiment.folds}, {"seconds", since(tf)}, {"folds", fr}};
+  }
 
   // Kinds that tabulate the BRDF (svd, sh-k, sh-r) see a measured BRDF made of
   // the training samples only, so their held-out columns are on unseen data.
@@ -251,18 +344,35 @@ RunEntry execute_run(const Plan& plan, const PlannedRun& pr, const SampleSet& sa
   for (const char* k : {"parameterization", "reciprocity", "terms", "texture_size"}) row[k] = "";
   kind.fill_row(c, out, row);
   std::vector<std::string> notes = out.notes;
+  if (!cv_note.empty()) notes.insert(notes.begin(), cv_note);
   fill_common_columns(c, out, mt, seconds, row, notes, rec);
   if (!cache_notes.empty()) rec["cache_rebuilt"] = cache_notes;
   notes.insert(notes.end(), cache_notes.begin(), cache_notes.end());
   {  // Validation on data the fit never saw, and its flags.
     const auto tv = Clock::now();
-    const ValidationScores vs = score_validation(*out.result, domain.get(), split ? &split->held : nullptr, lt);
+    ValidationScores vs = score_validation(*out.result, domain.get(), split ? &split->held : nullptr, lt);
+    if (fold_summary) {
+      vs.holdout = true;
+      vs.held = Metrics{};
+      vs.held.rel_mse = fold_summary->rel_mse_mean;
+      vs.held.cos_rmse = fold_summary->cos_rmse_mean;
+    }
     std::string scheme = validation_scheme(plan, b, domain.get(), split ? &*split : nullptr,
-                                           samples.valid_count());
+                                           fold_summary ? &*fold_summary : nullptr, samples.valid_count());
     if (!domain && plan.experiment.validation_pairs > 0)
       scheme = "no whole-domain columns: " + why_no_domain + (scheme.empty() ? "" : "; " + scheme);
     fill_validation_columns(vs, mt.rel_mse, scheme, row, notes);
     rec["validation"] = {{"scheme", scheme}, {"seconds", since(tv)}};
+    // Per channel (R, G, B): where a channel's error comes from.
+    json per_channel = json::object();
+    if (vs.domain) per_channel["val"] = channel_rel_mse(*out.result, *domain, lt);
+    if (split && vs.holdout) per_channel["holdout"] = channel_rel_mse(*out.result, split->held, lt);
+    if (!per_channel.empty()) rec["validation"]["channel_rel_mse"] = per_channel;
+    if (rec.contains("folds")) {
+      rec["validation"]["folds"] = rec["folds"]["folds"];
+      rec["validation"]["folds_seconds"] = rec["folds"]["seconds"];
+      rec.erase("folds");
+    }
   }
 
   if (plan.experiment.export_factors) kind.export_files(c, out);
