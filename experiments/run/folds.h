@@ -34,6 +34,13 @@ struct FoldSummary {
   std::vector<Metrics> per_fold;
   // "rel_mse sd 0.05, range 0.61-0.78 over 5 folds"
   std::string spread() const;
+  // The means as Metrics (rel_mse, cos_rmse; the rest 0).
+  Metrics mean() const {
+    Metrics m;
+    m.rel_mse = rel_mse_mean;
+    m.cos_rmse = cos_rmse_mean;
+    return m;
+  }
 };
 FoldSummary summarize_folds(const std::vector<Metrics>& per_fold);
 
