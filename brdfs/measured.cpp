@@ -1,6 +1,7 @@
 // MeasuredBrdf (scattered-data interpolation), measured_samples(), and the
 // catalogue's measured-file loaders and Cornell material models (see measured.h).
 #include "brdfs/measured.h"
+#include "brdfs/spectral.h"
 
 #include <algorithm>
 #include <cmath>
@@ -237,6 +238,7 @@ MeasuredOptions read_measured_options(const ParamDict& options) {
 
 struct SpectralOptions {
   int band = 0;  // 0 = RGB, else the band in nm
+  double gamut_floor = kGamutFloor;  // brdfs/spectral.h
   MeasuredOptions measured;
 };
 
@@ -245,6 +247,10 @@ SpectralOptions read_spectral_options(const ParamDict& options) {
   SpectralOptions o;
   o.band = options.get_int("band", 0);
   if (o.band != 0) spectral_band_index(o.band, options.origin() + ": band");
+  o.gamut_floor = options.get_scalar("gamut_floor", kGamutFloor);
+  if (!(o.gamut_floor >= 0.0 && o.gamut_floor <= 0.5))
+    throw std::invalid_argument(options.origin() + ": gamut_floor: expected a fraction of the luminance in 0..0.5, found " +
+                                std::to_string(o.gamut_floor));
   o.measured = read_measured_options(options);
   return o;
 }
@@ -264,7 +270,7 @@ BrdfPtr make_measured(const std::string& path, const std::string& name, SampleSe
 BrdfPtr load_spectral(const std::string& path, const SpectralOptions& o, const std::string& name,
                       bool astm) {
   const SpectralMeasurements m = astm ? read_astm(path) : read_pbrt_brdf(path);
-  return make_measured(path, name, spectral_to_samples(m, o.band), o.measured);
+  return make_measured(path, name, spectral_to_samples(m, o.band, nullptr, o.gamut_floor), o.measured);
 }
 
 const std::vector<ParamInfo> kSpectralParams = {
@@ -272,6 +278,9 @@ const std::vector<ParamInfo> kSpectralParams = {
      "a single band in nm (400, 410, ..., 700) in all three channels; "
      "absent: CIE 1931 -> linear sRGB, flat spectrum -> grey"},
     {"k", "8", "neighbours of the modified Shepard interpolation, 1..64"},
+    {"gamut_floor", "0.01",
+     "colour: every channel kept at >= this fraction of the sample's luminance by the gamut mapping, 0..0.5 "
+     "(0: out-of-gamut colours end at the gamut's edge with a channel at exactly 0)"},
 };
 
 struct CornellMaterial {
@@ -294,12 +303,12 @@ const CornellMaterial kCornell[] = {
 void register_measured_loaders(Catalogue& cat) {
   cat.add_loader(".astm", [](const std::string& path, const ParamDict& options) -> BrdfPtr {
     const SpectralOptions o = read_spectral_options(options);
-    options.check_unused("the .astm loader", {"band", "k"});
+    options.check_unused("the .astm loader", {"band", "k", "gamut_floor"});
     return load_spectral(path, o, "astm", true);
   });
   cat.add_loader(".brdf", [](const std::string& path, const ParamDict& options) -> BrdfPtr {
     const SpectralOptions o = read_spectral_options(options);
-    options.check_unused("the .brdf loader", {"band", "k"});
+    options.check_unused("the .brdf loader", {"band", "k", "gamut_floor"});
     return load_spectral(path, o, "brdf", false);
   });
   cat.add_loader(".csv", [](const std::string& path, const ParamDict& options) -> BrdfPtr {

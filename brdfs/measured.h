@@ -67,11 +67,13 @@ SpectralMeasurements read_pbrt_brdf(const std::string& path);
 // (theta_s, phi_s); value = RGB by spectral.h (band_nm == 0) or the single band
 // band_nm (400, 410, ..., 700) in all three channels. A record with a
 // negative value in a band that contributes is masked (its value set to -1).
-// Out-of-gamut colours are desaturated into the sRGB gamut at constant
-// luminance (spectral.h, step 4); their count goes to *desaturated.
+// Colours with a channel below gamut_floor x their luminance (out of gamut,
+// or at its edge) are desaturated at constant luminance until every channel
+// is gamut_floor x Y (spectral.h, step 4; kGamutFloor by default); their
+// count goes to *desaturated and into the description.
 // Throws std::invalid_argument for a band_nm that is not a band.
 SampleSet spectral_to_samples(const SpectralMeasurements& m, int band_nm,
-                              size_t* desaturated = nullptr);
+                              size_t* desaturated = nullptr, double gamut_floor = kGamutFloor);
 
 struct MeasuredOptions {
   int neighbours = 8;  // k of the interpolation below, 1..64 (loader option `k`)

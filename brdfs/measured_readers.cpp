@@ -258,7 +258,7 @@ SpectralMeasurements read_pbrt_brdf(const std::string& path) {
   return m;
 }
 
-SampleSet spectral_to_samples(const SpectralMeasurements& m, int band_nm, size_t* desaturated) {
+SampleSet spectral_to_samples(const SpectralMeasurements& m, int band_nm, size_t* desaturated, double gamut_floor) {
   const int band = band_nm == 0 ? -1 : spectral_band_index(band_nm, m.path + ": band");
   const Eigen::Matrix<double, 3, kSpectralBands> to_rgb = spectrum_to_rgb_matrix();
   const Eigen::Vector3d luminance = rgb_luminance_weights();
@@ -274,7 +274,7 @@ SampleSet spectral_to_samples(const SpectralMeasurements& m, int band_nm, size_t
       bool negative = false;
       for (int b = 0; b < kSpectralBands; ++b) negative |= spec[b] < 0.0;
       v = negative ? Rgb::Constant(-1.0) : spectrum_to_rgb(to_rgb, spec);
-      if (!negative && desaturate_into_gamut(v, luminance)) ++n_desaturated;
+      if (!negative && desaturate_into_gamut(v, luminance, gamut_floor)) ++n_desaturated;
     }
     s.push(from_spherical(a[0], a[1]), from_spherical(a[2], a[3]), v);
   }
@@ -288,6 +288,7 @@ SampleSet spectral_to_samples(const SpectralMeasurements& m, int band_nm, size_t
   else
     os << "rgb (CIE 1931 2deg, equal-energy white -> linear sRGB), " << n_desaturated
        << " desaturated into the sRGB gamut";
+  if (band < 0 && gamut_floor > 0.0) os << ", every channel kept at >= " << gamut_floor * 100.0 << "% of the luminance";
   s.description = os.str();
   // ASTM (Cornell) and pbrt "irregular isotropic" files hold isotropic BRDFs
   // given as functions of (theta_i, theta_s, |phi_s - phi_i|): isotropic,

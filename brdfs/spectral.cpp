@@ -111,17 +111,17 @@ Eigen::Vector3d rgb_luminance_weights() {
   return back.row(1).transpose() / cmf_sum[1];
 }
 
-bool desaturate_into_gamut(Rgb& rgb, const Eigen::Vector3d& w) {
+bool desaturate_into_gamut(Rgb& rgb, const Eigen::Vector3d& w, double floor) {
   const double lo = rgb.minCoeff();
-  if (!(lo < 0.0)) return false;
   const double y = w.dot(rgb.matrix());
+  if (!(lo < 0.0) && !(lo < floor * y)) return false;
   if (!(y > 0.0)) {
     rgb = Rgb::Zero();
     return true;
   }
-  // Y + t (lo - Y) = 0 for the smallest channel.
-  const double t = y / (y - lo);
-  rgb = (y + t * (rgb - y)).max(0.0);  // max() only removes rounding residue
+  // Y + t (lo - Y) = floor Y for the smallest channel.
+  const double t = y * (1.0 - floor) / (y - lo);
+  rgb = (y + t * (rgb - y)).max(floor * y);  // max() only removes rounding residue
   return true;
 }
 

@@ -19,7 +19,8 @@
 //     its samples have red < 0, down to -0.85 times the largest channel).
 //     spectrum_to_rgb() returns that as is; desaturate_into_gamut() (used by
 //     the measured loaders) mixes the colour with the grey of the same
-//     luminance Y until the smallest channel is exactly 0. That keeps Y (and
+//     luminance Y until the smallest channel is floor x Y (kGamutFloor for
+//     the loaders; 0 reaches the gamut's edge). That keeps Y (and
 //     the hue, roughly) and gives up saturation, unlike per-channel clipping,
 //     which would add red light and shift both.
 #pragma once
@@ -60,9 +61,18 @@ Rgb spectrum_to_rgb(const Eigen::Matrix<double, 3, kSpectralBands>& m, const dou
 // normalized so that a flat spectrum of value v has Y = v (w sums to 1).
 Eigen::Vector3d rgb_luminance_weights();
 
-// Step 4: if a channel of rgb is negative, replaces rgb by Y + t (rgb - Y)
-// with the largest t in [0, 1) that makes every channel >= 0 (Y = w . rgb);
-// rgb with Y <= 0 becomes 0. Returns whether rgb changed.
-bool desaturate_into_gamut(Rgb& rgb, const Eigen::Vector3d& luminance_weights);
+// The floor of step 4 the measured loaders use: every channel at least this
+// fraction of the sample's luminance Y (docs/design.md §8.2 "zero channels").
+// A gamut mapping to exactly 0 leaves channels the log metrics read as
+// ln(eps), far below their neighbours; 1% of Y is below every Cornell
+// paint's in-gamut channels but for the mapped ones (garnet-red: 5% of its
+// in-gamut samples have their smallest channel under 7% of Y).
+inline constexpr double kGamutFloor = 0.01;
+
+// Step 4: if a channel of rgb is below floor x Y (Y = w . rgb; floor in
+// [0, 1)), replaces rgb by Y + t (rgb - Y) with the largest t in [0, 1) that
+// makes every channel >= floor x Y; rgb with Y <= 0 becomes 0. Y is kept.
+// Returns whether rgb changed.
+bool desaturate_into_gamut(Rgb& rgb, const Eigen::Vector3d& luminance_weights, double floor = 0.0);
 
 }  // namespace bf

@@ -19,6 +19,7 @@
 #include "brdfs/params.h"
 #include "brdfs/safe_path.h"
 #include "brdfs/sampleset.h"
+#include "brdfs/spectral.h"
 #include "experiments/plan/plan_size.h"
 #include "experiments/plan/toml_depth.h"
 #include "experiments/common/cli_util.h"
@@ -49,7 +50,7 @@ const std::map<std::string, std::vector<std::string>>& key_table() {
   static const std::map<std::string, std::vector<std::string>> t = {
       {"top", {"experiment", "brdf", "sampling", "method", "scene"}},
       {"experiment", {"name", "seed", "out", "description", "jobs", "plots", "render", "export",
-                      "metric_eps", "validation_pairs", "holdout"}},
+                      "metric_eps", "validation_pairs", "holdout", "folds"}},
       {"sampling", {"kind", "resolution", "count", "seed", "path", "zip", "symmetries", "weights"}},
       {"scene", {"shade_rmse", "light", "intensity", "size", "environment", "environment_eps", "lighting_order",
                  "lighting_nodes"}},
@@ -101,6 +102,13 @@ ExperimentSettings read_experiment(const toml::table* t, Ctx& ctx, const std::st
   e.metric_eps = r.number("metric_eps", 1e-5, 0.0, 1.0, true);
   e.validation_pairs = static_cast<int>(r.integer("validation_pairs", e.validation_pairs, 0, 1000000));
   e.holdout = r.number("holdout", e.holdout, 0.0, 0.5, false);
+  e.folds = static_cast<int>(r.integer("folds", 0, 0, 1000000));
+  if (e.folds == 1)
+    r.fail("folds", "expected 0 (off: the single `holdout` fraction) or a number of folds >= 2, found 1");
+  else if (e.folds >= 2 && r.has("holdout"))
+    r.fail("folds", "folds = " + std::to_string(e.folds) +
+                        " holds every sample out once and replaces the single `holdout` fraction, but holdout = " +
+                        format_number(e.holdout) + " is set too: expected one of them");
   r.finish(config_keys("experiment"), "[experiment]");
   return e;
 }
@@ -261,6 +269,9 @@ void read_brdfs(const toml::node* node, Ctx& ctx, std::vector<BrdfVariant>& out)
           b.identity = {{"file", fs::path(src).filename().string()},
                         {"digest", file_hash(resolved)},
                         {"options", bp.values}};
+          // Spectral files: the gamut mapping's floor shapes the samples (brdfs/spectral.h).
+          const std::string ext = fs::path(resolved).extension().string();
+          if (ext == ".astm" || ext == ".brdf") b.identity["gamut_floor"] = kGamutFloor;
           b.label = name.empty() ? src : name;
         } else {
           b.brdf = Catalogue::global().make(src, bp.params);
@@ -574,6 +585,20 @@ Plan parse_plan(const std::string& text, const std::string& path, const std::vec
                     "\" is scored on the validation set, but [experiment] validation_pairs = 0 (no set)");
   }
 
+  // A key chosen by held-out error needs held-out samples: raw samples with
+  // a held-out fraction or folds.
+  for (const auto& m : plan.methods) {
+    if (!m.cv) continue;
+    const std::string rule = m.cv->key + " = \"cv\" chooses it by held-out error, ";
+    for (const auto& s : plan.samplings)
+      if (s.kind != "measured" && s.kind != "file")
+        ctx.issue(m.where, "method." + m.cv->key,
+                  rule + "which only raw samples have (sampling kind \"measured\" or \"file\"), found kind \"" +
+                      s.kind + "\" (" + s.where + "): give a number");
+    if (plan.experiment.folds < 2 && !(plan.experiment.holdout > 0))
+      ctx.issue(m.where, "method." + m.cv->key, rule + "but [experiment] holdout = 0 and folds = 0 hold nothing out: set one");
+  }
+
   // Combinations that need a measured BRDF.
   for (const auto& s : plan.samplings) {
     if (s.kind != "measured") continue;
@@ -585,7 +610,7 @@ Plan parse_plan(const std::string& text, const std::string& path, const std::vec
   }
   if (!ctx.issues.empty()) throw ConfigError(ctx.issues);
 
-  const json common = {{"v", kRunFormatVersion},
+  json common = {{"v", kRunFormatVersion},
                        {"metric_eps", plan.experiment.metric_eps},
                        {"render", plan.experiment.render},
                        {"export", plan.experiment.export_factors},
@@ -593,6 +618,8 @@ Plan parse_plan(const std::string& text, const std::string& path, const std::vec
                        {"validation", {{"pairs", plan.experiment.validation_pairs},
                                        {"holdout", plan.experiment.holdout},
                                        {"seed", validation_seed(plan.experiment.seed)}}}};
+  // Only when on: runs without folds keep their ids.
+  if (plan.experiment.folds > 0) common["validation"]["folds"] = plan.experiment.folds;
   std::set<std::string> ids;
   json all = json::array();
   for (size_t b = 0; b < plan.brdfs.size(); ++b)

@@ -16,7 +16,8 @@ using nlohmann::json;
 std::vector<KeySpec> fit_keys(const KeySpec& texture_size) {
   return {texture_size,
           num_key("smoothing", 0.0, FitOptions::kMaxWeight, false, "1e-3",
-                  "Laplacian weight relative to the mean sample weight per texel"),
+                  "Laplacian weight relative to the mean sample weight per texel; `\"cv\"` (mccool, fit; raw "
+                  "samples): chosen by held-out error from 1e-4, 1e-3, 1e-2, 0.1, 1 (docs/design.md §4.1 \"cv\")"),
           num_key("eps", 0.0, 1.0, true, "1e-5", "log-transform eps of the fit (docs/design.md §2)"),
           num_key("extrapolation_prior", 0.0, FitOptions::kMaxWeight, false, "0",
                   "weight (in mean sample weights) pulling the fit toward the data's mean log value where no "
@@ -67,7 +68,11 @@ const KeySpec& refine_key(const std::string& name) {
 
 void read_fit_options(Reader& r, FitOptions& f, json& o) {
   f.eps = r.number(fit_key("eps"), f.eps);
-  f.smoothing = r.number(fit_key("smoothing"), f.smoothing);
+  bool cv = false;
+  if (r.has("smoothing"))
+    if (const toml::node* n = r.take("smoothing"); n && n->is_string())
+      cv = n->value<std::string>() == std::optional<std::string>("cv");
+  if (!cv) f.smoothing = r.number(fit_key("smoothing"), f.smoothing);
   f.extrapolation_prior = r.number(fit_key("extrapolation_prior"), f.extrapolation_prior);
   f.subtract_eps = r.boolean(fit_key("subtract_eps"), f.subtract_eps);
   f.clamp_log_range = r.boolean(fit_key("clamp_log_range"), f.clamp_log_range);
@@ -75,7 +80,7 @@ void read_fit_options(Reader& r, FitOptions& f, json& o) {
   const std::string solver = r.choice(fit_key("solver"), "auto");
   f.solver = parse_solver(solver);
   o["eps"] = f.eps;
-  o["smoothing"] = f.smoothing;
+  o["smoothing"] = cv ? json("cv") : json(f.smoothing);  // "cv": chosen per run (finish_refine_options)
   o["extrapolation_prior"] = f.extrapolation_prior;
   o["subtract_eps"] = f.subtract_eps;
   // Only when off: the default keeps the run ids of configs written before the key.
@@ -112,6 +117,19 @@ void validate_fit_options(Reader& r, const MethodVariant& m) {
 void finish_refine_options(Reader& r, MethodVariant& m, json& o) {
   HomomorphicOptions& ho = homomorphic_options(m);
   RefineOptions& ro = ho.refine;
+  const bool refine_follows = ro.smoothing < 0;  // the refinement uses the fit's smoothing
+  if (o.value("smoothing", json()) == json("cv")) {
+    if (m.kind != "mccool" && m.kind != "fit")
+      r.fail("smoothing", "\"cv\" is chosen for kinds mccool and fit (one refit per candidate and fold), found kind " +
+                              m.kind + ": give a number, or choose it with kind fit at the search's projections");
+    m.cv = MethodVariant::HeldOutChoice{
+        "smoothing", kCvSmoothingLadder, [refine_follows](MethodVariant& mv, double v) {
+          HomomorphicOptions& h = homomorphic_options(mv);
+          h.fit.smoothing = v;
+          h.search.fit.smoothing = v;
+          if (refine_follows) h.refine.smoothing = v;
+        }};
+  }
   if (ro.smoothing < 0) ro.smoothing = ho.fit.smoothing;
   if (m.refine != "none") o["refine_smoothing"] = ro.smoothing;
   ro.threads = 1;

@@ -27,6 +27,11 @@ inline const HomomorphicOptions& homomorphic_options(const MethodVariant& m) {
   return kind_options<HomomorphicOptions>(m);
 }
 
+// `smoothing = "cv"` (mccool, fit; raw samples): the candidates, tried by
+// held-out error (k-fold, or the single held-out fraction), in this order;
+// the first of equal errors wins. Decades around the default 1e-3.
+inline const std::vector<double> kCvSmoothingLadder = {1e-4, 1e-3, 1e-2, 1e-1, 1.0};
+
 // The fit keys (texture_size with the given default docs, smoothing, eps,
 // subtract_eps, solve_last, solver) and the refinement keys.
 std::vector<KeySpec> fit_keys(const KeySpec& texture_size);

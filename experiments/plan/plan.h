@@ -6,6 +6,7 @@
 
 #include <any>
 #include <cstdint>
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <stdexcept>
@@ -50,6 +51,10 @@ struct ExperimentSettings {
   // fraction of measured/file samples held out of the fit.
   int validation_pairs = 4096;
   double holdout = 0.1;
+  // k-fold hold-out instead of the single fraction (experiments/run/folds.h):
+  // 0 = off; k >= 2 fits each method k times without one fold each, and the
+  // run's own fit on every sample.
+  int folds = 0;
 };
 
 // The seed of the validation set and of the held-out choice, derived from
@@ -144,6 +149,15 @@ struct MethodVariant {
   uint64_t seed = 0;        // the kind's seed (0 when the kind has none)
   int cores = 1;            // cores the method keeps busy by itself (scheduling, runner.h)
   std::any typed;           // the kind's own options (kind_options<T>)
+  // A key chosen at run time by held-out error (`smoothing = "cv"` of mccool
+  // and fit, docs/design.md §4.1 "cv"): its candidates in order and how one
+  // is set on a copy of the variant. Unset: nothing is chosen.
+  struct HeldOutChoice {
+    std::string key;
+    std::vector<double> ladder;
+    std::function<void(MethodVariant&, double)> apply;
+  };
+  std::optional<HeldOutChoice> cv;
 };
 
 // The kind's typed options of m. The mutable form creates a T{} the first

@@ -14,11 +14,13 @@
 #include <new>
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <condition_variable>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
+#include <limits>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -38,6 +40,7 @@
 #include "experiments/methods/method_kind.h"
 #include "experiments/report/validation.h"
 #include "experiments/run/symmetry_prep.h"
+#include "experiments/run/folds.h"
 #if __has_include("brdfs/measured.h")
 #include "brdfs/measured.h"
 #define BF_RUNNER_HAVE_MEASURED 1
@@ -120,7 +123,7 @@ class RenderCache {
 
 // The validation scheme of a run, in words (the `validation` column).
 std::string validation_scheme(const Plan& plan, const BrdfVariant& b, const SampleSet* domain,
-                              const HoldoutSplit* split, size_t all_valid) {
+                              const HoldoutSplit* split, const FoldSummary* folds, size_t all_valid) {
   std::vector<std::string> parts;
   if (domain)
     parts.push_back("domain: " + std::to_string(domain->size()) + " stratified pairs (seed " +
@@ -133,6 +136,11 @@ std::string validation_scheme(const Plan& plan, const BrdfVariant& b, const Samp
   if (split)
     parts.push_back("held out: " + std::to_string(split->held.valid_count()) + " of " + std::to_string(all_valid) +
                     " samples (" + format_number(plan.experiment.holdout * 100.0) + "%), not fitted");
+  if (folds)
+    parts.push_back("held out: " + std::to_string(folds->folds) + "-fold (seed " +
+                    std::to_string(validation_seed(plan.experiment.seed)) + "), each of " +
+                    std::to_string(all_valid) + " samples held out once; holdout_* are the mean over the folds (" +
+                    folds->spread() + "); the scored fit uses every sample");
   return join(parts, "; ");
 }
 
@@ -188,6 +196,139 @@ void set_presentation(Row& row, const Plan& plan, const PlannedRun& r) {
   row["sampling"] = plan.samplings[r.sampling].label;
 }
 
+// What the held-out fits of a run found (held_out_stage).
+struct HeldOutStage {
+  std::optional<FoldSummary> folds;  // with experiment.folds: the folds' scores
+  json folds_record;                 // each fold's sizes and scores (run.json validation.folds)
+  double folds_seconds = 0;
+  std::string cv_note;               // with a key chosen by held-out error: the choice in words
+};
+
+// The held-out data of a run on raw samples (experiments/report/validation.h,
+// experiments/run/folds.h): a fraction held out of the fit, or with
+// experiment.folds the k folds, fitted separately (nothing is held out of the
+// run's own fit then). Neither for grid and stratified samplings.
+struct HeldOutData {
+  std::vector<HoldoutSplit> folds;
+  std::optional<HoldoutSplit> split;
+};
+HeldOutData held_out_data(const Plan& plan, const PlannedRun& pr, const SampleSet& samples) {
+  HeldOutData d;
+  const SamplingVariant& s = plan.samplings[pr.sampling];
+  const uint64_t seed = validation_seed(plan.experiment.seed);
+  if (plan.experiment.folds >= 2 && holds_out(s, ExperimentSettings{}))
+    d.folds = split_folds(samples, plan.experiment.folds, seed);
+  else if (holds_out(s, plan.experiment))
+    d.split = split_holdout(samples, plan.experiment.holdout, seed);
+  return d;
+}
+
+// run.json validation entries beyond the scheme: the per-channel rel_mse
+// (R, G, B) of the run's fit on the whole-domain set and the held-out
+// samples, and each fold's scores.
+void record_held_out(json& v, const ValidationScores& vs, const Brdf& result, const SampleSet* domain,
+                     const HoldoutSplit* split, const LogTransform& lt, const HeldOutStage& held) {
+  json per_channel = json::object();
+  if (vs.domain && domain) per_channel["val"] = channel_rel_mse(result, *domain, lt);
+  if (split && vs.holdout) per_channel["holdout"] = channel_rel_mse(result, split->held, lt);
+  if (!per_channel.empty()) v["channel_rel_mse"] = per_channel;
+  if (held.folds) {
+    v["folds"] = held.folds_record;
+    v["folds_seconds"] = held.folds_seconds;
+  }
+}
+
+// The held-out fits of a run on raw samples (docs/design.md §4.1): for a key
+// chosen by held-out error (MethodVariant::cv), every candidate fitted without
+// the held-out samples (each fold, or the single fraction) and the choice set
+// on m; with folds, the method fitted without each fold. Entries go to rec.
+HeldOutStage held_out_stage(const Plan& plan, const PlannedRun& pr, const MethodKind& kind, MethodVariant& m,
+                            const SymmetryChoice& sym, const IsotropyResult& isotropy, const fs::path& run_dir,
+                            RenderCache& renders, const std::vector<HoldoutSplit>* folds,
+                            const HoldoutSplit* split, json& rec) {
+  const BrdfVariant& b = plan.brdfs[pr.brdf];
+  // One fit of the method without the held-out samples h.held (the same
+  // preparation as the run's own fit: symmetries, the training-only BRDF of
+  // the tabulating kinds, scene weights), scored on them.
+  auto held_out_score = [&](const HoldoutSplit& h, const MethodVariant& mv) {
+    const SampleSet view = fit_set(h.train, sym, nullptr);
+    const LogTransform flt = LogTransform::of(h.train, plan.experiment.metric_eps);
+    BrdfVariant fb = b;
+#ifdef BF_RUNNER_HAVE_MEASURED
+    if (b.measured)
+      if (BrdfPtr t = measured_from_training(*b.brdf, h.train)) fb.brdf = std::move(t);
+#endif
+    std::optional<SampleSet> wv;
+    if (const auto wf = mv.options.find("weight_fit"); wf != mv.options.end())
+      wv = scene_weighted(view, scene_pairs(*b.brdf, plan.scene), wf->at("floor").get<double>());
+    const RunContext fc{plan, pr, fb, mv, wv ? *wv : view, flt, isotropy, run_dir,
+                        [&] { return renders.get(plan, pr.brdf); }};
+    const MethodOutcome fo = kind.run(fc);
+    if (!fo.result) throw std::runtime_error("method " + mv.kind + " returned no factorization");
+    return evaluate_metrics(*fo.result, h.held, flt);
+  };
+  // A key chosen by held-out error (MethodVariant::cv): each candidate fitted
+  // without the held-out samples (every fold, or the single fraction), the
+  // lowest mean held-out rel_mse chosen; the run's fit then uses the choice.
+  std::vector<Metrics> chosen_folds;
+  HeldOutStage st;
+  std::string& cv_note = st.cv_note;
+  const bool use_folds = folds != nullptr;
+  if (m.cv) {
+    if (!use_folds && !split)
+      throw std::invalid_argument(m.cv->key + " = \"cv\" needs held-out samples (raw samples with holdout or folds)");
+    const auto tc = Clock::now();
+    json cands = json::array();
+    std::vector<std::string> words;
+    size_t best = 0;
+    double best_err = std::numeric_limits<double>::infinity();
+    std::vector<std::vector<Metrics>> per_candidate;
+    for (size_t i = 0; i < m.cv->ladder.size(); ++i) {
+      MethodVariant mv = m;
+      m.cv->apply(mv, m.cv->ladder[i]);
+      std::vector<Metrics> sc;
+      if (use_folds)
+        for (const HoldoutSplit& h : *folds) sc.push_back(held_out_score(h, mv));
+      else
+        sc.push_back(held_out_score(*split, mv));
+      const FoldSummary fs = summarize_folds(sc);
+      cands.push_back({{"value", m.cv->ladder[i]},
+                       {"holdout_rel_mse", fs.rel_mse_mean},
+                       {"holdout_cos_rmse", fs.cos_rmse_mean}});
+      words.push_back(format_short(format_number(m.cv->ladder[i])) + ": " +
+                      format_short(format_number(fs.rel_mse_mean)));
+      if (std::isfinite(fs.rel_mse_mean) && fs.rel_mse_mean < best_err) best_err = fs.rel_mse_mean, best = i;
+      per_candidate.push_back(std::move(sc));
+    }
+    const double chosen = m.cv->ladder[best];
+    const std::string by = use_folds ? std::to_string(plan.experiment.folds) + "-fold mean held-out rel_mse"
+                                     : "held-out rel_mse of the held-out fraction";
+    m.cv->apply(m, chosen);
+    if (use_folds) chosen_folds = per_candidate[best];
+    rec["cv"] = {{"key", m.cv->key}, {"by", by}, {"candidates", cands}, {"chosen", chosen},
+                 {"seconds", since(tc)}};
+    cv_note = m.cv->key + " = \"cv\" chose " + format_short(format_number(chosen)) + " by " + by + " (" +
+              join(words, ", ") + ")";
+  }
+  if (use_folds) {
+    const auto tf = Clock::now();
+    std::vector<Metrics> per_fold;
+    json fr = json::array();
+    for (size_t f = 0; f < folds->size(); ++f) {
+      const HoldoutSplit& h = (*folds)[f];
+      per_fold.push_back(chosen_folds.empty() ? held_out_score(h, m) : chosen_folds[f]);
+      fr.push_back({{"train", h.train.valid_count()},
+                    {"held", h.held.valid_count()},
+                    {"holdout_rel_mse", per_fold.back().rel_mse},
+                    {"holdout_cos_rmse", per_fold.back().cos_rmse}});
+    }
+    st.folds = summarize_folds(per_fold);
+    st.folds_record = fr;
+    st.folds_seconds = since(tf);
+  }
+  return st;
+}
+
 // Executes one run and writes its files and run.json; the caller writes the
 // DONE marker (done_marker, write_done_marker). cache_notes: what was found
 // wrong with caches this run would have used (rebuilt), for its notes.
@@ -206,11 +347,11 @@ RunEntry execute_run(const Plan& plan, const PlannedRun& pr, const SampleSet& sa
   Row& row = e.row;
   set_presentation(row, plan, pr);
   json rec = run_record(plan, pr, samples);
-  // Validation data (experiments/report/validation.h): raw samples lose a held-out
-  // fraction before the fit; the whole-domain set is shared by the BRDF's runs.
-  std::optional<HoldoutSplit> split;
-  if (holds_out(plan.samplings[pr.sampling], plan.experiment))
-    split = split_holdout(samples, plan.experiment.holdout, validation_seed(plan.experiment.seed));
+  // Validation data: held-out samples or folds; the whole-domain set is shared by the BRDF's runs.
+  HeldOutData hd = held_out_data(plan, pr, samples);
+  const std::vector<HoldoutSplit>& folds = hd.folds;
+  const std::optional<HoldoutSplit>& split = hd.split;
+  const bool use_folds = !folds.empty();
   const SampleSet& fit_samples = split ? split->train : samples;
   // Symmetries (experiments/run/symmetry_prep.h): the fit sees each raw training
   // sample's orbit; metrics and the held-out split stay on the raw samples.
@@ -223,12 +364,17 @@ RunEntry execute_run(const Plan& plan, const PlannedRun& pr, const SampleSet& sa
   std::string why_no_domain;
   const auto domain = b.brdf->whole_domain(&why_no_domain) ? renders.validation(plan, pr.brdf) : nullptr;
   const LogTransform lt = LogTransform::of(fit_samples, plan.experiment.metric_eps);
-  const MethodVariant m = with_tolerance_scorer(plan.methods[pr.method], plan, pr, renders, domain, lt);
+  MethodVariant m = with_tolerance_scorer(plan.methods[pr.method], plan, pr, renders, domain, lt);
 
   // Azimuthal-invariance test of the BRDF (factor/isotropy.h): results column `isotropic`.
   const IsotropyResult isotropy = test_isotropy(*b.brdf);
   row["isotropic"] = isotropy.isotropic ? "true" : "false";
   rec["isotropy"] = isotropy.describe();
+
+  // Held-out fits: a key chosen by held-out error, the k folds.
+  const HeldOutStage held = held_out_stage(plan, pr, kind, m, sym, isotropy, run_dir, renders,
+                                           use_folds ? &folds : nullptr, split ? &*split : nullptr, rec);
+  const std::optional<FoldSummary>& fold_summary = held.folds;
 
   // Kinds that tabulate the BRDF (svd, sh-k, sh-r) see a measured BRDF made of
   // the training samples only, so their held-out columns are on unseen data.
@@ -255,18 +401,21 @@ RunEntry execute_run(const Plan& plan, const PlannedRun& pr, const SampleSet& sa
   for (const char* k : {"parameterization", "reciprocity", "terms", "texture_size"}) row[k] = "";
   kind.fill_row(c, out, row);
   std::vector<std::string> notes = out.notes;
+  if (!held.cv_note.empty()) notes.insert(notes.begin(), held.cv_note);
   fill_common_columns(c, out, mt, seconds, row, notes, rec);
   if (!cache_notes.empty()) rec["cache_rebuilt"] = cache_notes;
   notes.insert(notes.end(), cache_notes.begin(), cache_notes.end());
   {  // Validation on data the fit never saw, and its flags.
     const auto tv = Clock::now();
-    const ValidationScores vs = score_validation(*out.result, domain.get(), split ? &split->held : nullptr, lt);
+    ValidationScores vs = score_validation(*out.result, domain.get(), split ? &split->held : nullptr, lt);
+    if (fold_summary) vs.holdout = true, vs.held = fold_summary->mean();
     std::string scheme = validation_scheme(plan, b, domain.get(), split ? &*split : nullptr,
-                                           samples.valid_count());
+                                           fold_summary ? &*fold_summary : nullptr, samples.valid_count());
     if (!domain && plan.experiment.validation_pairs > 0)
       scheme = "no whole-domain columns: " + why_no_domain + (scheme.empty() ? "" : "; " + scheme);
     fill_validation_columns(vs, mt.rel_mse, scheme, row, notes);
     rec["validation"] = {{"scheme", scheme}, {"seconds", since(tv)}};
+    record_held_out(rec["validation"], vs, *out.result, domain.get(), split ? &*split : nullptr, lt, held);
   }
 
   if (plan.experiment.export_factors) kind.export_files(c, out);

@@ -494,3 +494,66 @@ TEST_CASE("cli: a bad measured file exits 2 with one line and writes nothing") {
   CHECK_THAT(err, Contains("truncated file?"));
   CHECK(run_cli("eval --brdf cayman:band=550 --wi 0,0,1 --wo 0,0,1", &err) == 0);
 }
+
+TEST_CASE("spectral: the gamut mapping keeps every channel at the floor fraction of the luminance") {
+  const Eigen::Vector3d w = rgb_luminance_weights();
+  REQUIRE(kGamutFloor > 0.0);
+  // Out of gamut: the smallest channel lands on floor x Y, Y kept.
+  Rgb v(-0.1, 0.3, 0.9);
+  const double y = w.dot(v.matrix());
+  CHECK(desaturate_into_gamut(v, w, kGamutFloor));
+  CHECK(v.minCoeff() == Approx(kGamutFloor * y).epsilon(1e-12));
+  CHECK(w.dot(v.matrix()) == Approx(y).epsilon(1e-12));
+  // In gamut but with a channel below the floor (a desaturated residue): lifted.
+  Rgb tiny(1e-19, 0.3, 0.9);
+  CHECK(desaturate_into_gamut(tiny, w, kGamutFloor));
+  CHECK(tiny.minCoeff() == Approx(kGamutFloor * w.dot(Rgb(1e-19, 0.3, 0.9).matrix())).epsilon(1e-12));
+  // Above the floor: unchanged.
+  Rgb fine(0.2, 0.3, 0.4);
+  CHECK_FALSE(desaturate_into_gamut(fine, w, kGamutFloor));
+  CHECK(fine.isApprox(Rgb(0.2, 0.3, 0.4)));
+}
+
+TEST_CASE("spectral: no Cornell channel is an exact zero - none reads as ln(eps) in the metrics") {
+  // krylon-blue had one channel at exactly 0 in 919 of its 1,439 samples (the
+  // gamut mapping stopped at 0), which the log metrics read as ln(eps). With
+  // gamut_floor = 0 (the old mapping) this test fails: zeros = 919 on krylon.
+  const Eigen::Vector3d w = rgb_luminance_weights();
+  for (const char* name : {"krylon-blue", "cayman", "acryl-blue", "mystique", "garnet-red"}) {
+    INFO(name);
+    const SampleSet s = measured_samples(*Catalogue::builtin().make(name));
+    // The metrics' log transform (factor/metrics.h): g = ln((f + eps A) / A), A the channel mean.
+    const double eps = 1e-5;
+    Rgb a = Rgb::Zero();
+    for (size_t k = 0; k < s.size(); ++k)
+      if (s.valid[k]) a += s.value[k] / double(s.valid_count());
+    size_t zeros = 0, at_eps = 0;
+    for (size_t k = 0; k < s.size(); ++k) {
+      if (!s.valid[k]) continue;
+      const double y = w.dot(s.value[k].matrix());
+      if (!(y > 0)) continue;  // a black sample (every band 0) is black in every channel
+      for (int c = 0; c < 3; ++c) {
+        zeros += s.value[k][c] == 0.0;
+        // In the log metrics, no channel lies more than ln(1 / floor) below the sample's luminance
+        // (a zero channel read as ln(eps), 11.5 below A and far further below its sample).
+        at_eps += std::log((s.value[k][c] + eps * a[c]) / a[c]) <
+                  std::log((kGamutFloor * y + eps * a[c]) / a[c]) - 1e-9;
+        CHECK(s.value[k][c] >= kGamutFloor * y * (1 - 1e-9));
+      }
+    }
+    CHECK(zeros == 0);
+    CHECK(at_eps == 0);
+    CHECK(s.description.find("kept at >= 1% of the luminance") != std::string::npos);
+  }
+}
+
+TEST_CASE("spectral: gamut_floor = 0 is the old mapping to the gamut's edge - and a bad floor is refused") {
+  const SampleSet edge = measured_samples(*Catalogue::builtin().make("krylon-blue:gamut_floor=0"));
+  const Eigen::Vector3d w = rgb_luminance_weights();
+  size_t zeros = 0;
+  for (size_t k = 0; k < edge.size(); ++k)
+    if (edge.valid[k] && w.dot(edge.value[k].matrix()) > 0 && edge.value[k].minCoeff() == 0.0) ++zeros;
+  CHECK(zeros > 900);  // measured: 919 samples with one channel at exactly 0
+  CHECK_THROWS_WITH(Catalogue::builtin().make("krylon-blue:gamut_floor=0.7"),
+                    Catch::Contains("gamut_floor") && Catch::Contains("0..0.5") && Catch::Contains("0.7"));
+}

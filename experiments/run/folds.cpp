@@ -1,0 +1,116 @@
+// k-fold splits (see folds.h).
+#include "experiments/run/folds.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include "experiments/report/outputs.h"
+
+namespace bf {
+
+namespace {
+
+// SplitMix64: a portable generator (std::shuffle's algorithm is unspecified).
+uint64_t splitmix(uint64_t& x) {
+  uint64_t z = (x += 0x9e3779b97f4a7c15ULL);
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+  return z ^ (z >> 31);
+}
+
+}  // namespace
+
+std::vector<HoldoutSplit> split_folds(const SampleSet& s, int k, uint64_t seed) {
+  std::vector<size_t> valid;
+  for (size_t i = 0; i < s.size(); ++i)
+    if (s.valid[i]) valid.push_back(i);
+  const size_t n = valid.size();
+  if (k < 2)
+    throw std::invalid_argument("experiment.folds: expected a number of folds >= 2 (0 = off), found " +
+                                std::to_string(k));
+  if (static_cast<size_t>(k) > n)
+    throw std::invalid_argument("experiment.folds: expected at most the " + std::to_string(n) +
+                                " valid samples (each fold holds one at least), found " + std::to_string(k));
+  const size_t largest = (n + static_cast<size_t>(k) - 1) / static_cast<size_t>(k);
+  if (n - largest < 2)
+    throw std::invalid_argument("experiment.folds: " + std::to_string(n) + " valid samples in " +
+                                std::to_string(k) + " folds leave " + std::to_string(n - largest) +
+                                " to fit without a fold; expected at least 2");
+  // Full Fisher-Yates; position i of the order goes to fold i mod k.
+  uint64_t state = seed;
+  for (size_t i = 0; i + 1 < n; ++i) {
+    const size_t j = i + static_cast<size_t>(splitmix(state) % (n - i));
+    std::swap(valid[i], valid[j]);
+  }
+  std::vector<int> fold_of(s.size(), -1);
+  for (size_t i = 0; i < n; ++i) fold_of[valid[i]] = static_cast<int>(i % static_cast<size_t>(k));
+  std::vector<HoldoutSplit> out(static_cast<size_t>(k));
+  const bool weighted = !s.weight.empty();
+  for (int f = 0; f < k; ++f) {
+    HoldoutSplit& h = out[static_cast<size_t>(f)];
+    for (size_t i = 0; i < s.size(); ++i) {
+      SampleSet& dst = fold_of[i] == f ? h.held : h.train;
+      dst.wi.push_back(s.wi[i]);
+      dst.wo.push_back(s.wo[i]);
+      dst.value.push_back(s.value[i]);
+      dst.valid.push_back(s.valid[i]);
+      if (weighted) dst.weight.push_back(s.weight[i]);
+    }
+    h.train.invalid_value = s.invalid_value;
+    h.train.invalid_horizon = s.invalid_horizon;
+    h.train.invalid_weight = s.invalid_weight;
+    h.train.symmetries = h.held.symmetries = s.symmetries;
+    const std::string name = "fold " + std::to_string(f + 1) + " of " + std::to_string(k);
+    h.train.description = s.description + " without " + name + " (" + std::to_string(h.held.size()) + " samples)";
+    h.held.description = name + " of " + s.description;
+  }
+  return out;
+}
+
+FoldSummary summarize_folds(const std::vector<Metrics>& per_fold) {
+  FoldSummary s;
+  s.per_fold = per_fold;
+  s.folds = static_cast<int>(per_fold.size());
+  if (per_fold.empty()) return s;
+  s.rel_mse_min = s.rel_mse_max = per_fold[0].rel_mse;
+  for (const Metrics& m : per_fold) {
+    s.rel_mse_mean += m.rel_mse / s.folds;
+    s.cos_rmse_mean += m.cos_rmse / s.folds;
+    s.rel_mse_min = std::min(s.rel_mse_min, m.rel_mse);
+    s.rel_mse_max = std::max(s.rel_mse_max, m.rel_mse);
+  }
+  if (s.folds > 1) {
+    double ss = 0;
+    for (const Metrics& m : per_fold) ss += (m.rel_mse - s.rel_mse_mean) * (m.rel_mse - s.rel_mse_mean);
+    s.rel_mse_sd = std::sqrt(ss / (s.folds - 1));
+  }
+  return s;
+}
+
+std::array<double, 3> channel_rel_mse(const Brdf& approx, const SampleSet& s, const LogTransform& lt) {
+  long double sum[3] = {0, 0, 0}, wsum = 0;
+  for (size_t k = 0; k < s.size(); ++k) {
+    if (!s.valid[k]) continue;
+    const double w = s.weight_of(k);
+    const Rgb a = approx.eval(s.wi[k], s.wo[k]);
+    for (int c = 0; c < 3; ++c) {
+      double d = std::isfinite(a[c]) ? lt.g(c, a[c]) - lt.g(c, s.value[k][c]) : 1e150;
+      if (!std::isfinite(d)) d = 1e150;  // as evaluate_metrics: an error of 1e300
+      sum[c] += static_cast<long double>(w) * d * d;
+    }
+    wsum += w;
+  }
+  std::array<double, 3> out{0, 0, 0};
+  if (wsum > 0)
+    for (int c = 0; c < 3; ++c) out[c] = std::min(1e300, static_cast<double>(sum[c] / wsum));
+  return out;
+}
+
+std::string FoldSummary::spread() const {
+  return "rel_mse sd " + format_short(format_number(rel_mse_sd)) + ", range " +
+         format_short(format_number(rel_mse_min)) + "-" + format_short(format_number(rel_mse_max)) + " over " +
+         std::to_string(folds) + " folds";
+}
+
+}  // namespace bf
