@@ -80,8 +80,8 @@ Parameterization other(Parameterization p) {
 }  // namespace
 
 PlantedProductBrdf planted_rotation_brdf(int index, int terms, Parameterization param) {
-  if (terms != 2 && terms != 3)
-    throw std::invalid_argument("planted_rotation_brdf: terms: expected 2 or 3, found " + std::to_string(terms));
+  if (terms < 2 || terms > 4)
+    throw std::invalid_argument("planted_rotation_brdf: terms: expected 2, 3 or 4, found " + std::to_string(terms));
   std::mt19937_64 rng(0x5eed0000ull + static_cast<uint64_t>(index) * 7919ull + terms * 104729ull +
                       (param == Parameterization::HalfDiff ? 1 : 0));
   std::uniform_real_distribution<double> U(0, 1);
@@ -89,11 +89,12 @@ PlantedProductBrdf planted_rotation_brdf(int index, int terms, Parameterization 
   std::vector<PlantedTerm> ts(2);
   ts[0] = {param, plane(R, 0), PlaneFunction::random(rng)};
   ts[1] = {param, plane(R, 2), PlaneFunction::random(rng)};
-  if (terms == 3) {
+  if (terms >= 3) {
     const Rotation4 R2 = Rotation4::random(rng);
     ts.push_back({other(param), plane(R2, 0), PlaneFunction::random(rng)});
+    if (terms == 4) ts.push_back({other(param), plane(R2, 2), PlaneFunction::random(rng)});
   }
-  const double share = terms == 3 ? 2.0 / 3.0 : 1.0;
+  const double share = 2.0 / terms;
   for (PlantedTerm& t : ts) scale_to_range(t, share * std::log(10.0) * (1.25 + 0.25 * U(rng)));
   return PlantedProductBrdf(std::move(ts), "planted-rotation(" + std::to_string(index) + ", " +
                                                std::to_string(terms) + " terms, " + to_string(param) + ")");

@@ -54,9 +54,10 @@ class PlantedProductBrdf final : public Brdf {
 // by index) and, for terms = 2, the textures a(plane A of R) + b(plane B of R),
 // both in `param`; for terms = 3, a third texture on the first plane of a
 // second random rotation in the other parameterization (a mixture, like
-// McCool's form). Each a_t is scaled so its range over the grid points is
-// 10^1.25..10^1.5 (3 terms: 2/3 of that), so f spans about 10^2.5..10^3.
-// Throws std::invalid_argument for terms other than 2 or 3.
+// McCool's form); for terms = 4, a fourth texture on that rotation's second
+// plane (two planes in each parameterization). Each a_t is scaled so its range
+// over the grid points is 10^1.25..10^1.5 times 2 / terms, so f spans about
+// 10^2.5..10^3. Throws std::invalid_argument for terms other than 2, 3 or 4.
 PlantedProductBrdf planted_rotation_brdf(int index, int terms, Parameterization param);
 
 // A BRDF of exact McCool form p(wi) q(h) p(wo) (random smooth p and q, seeded):

@@ -20,6 +20,12 @@ double now_seconds() {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
+// Searches of up to this many terms (per-term parameterization, final_joint)
+// re-read their terms under the joint objective (Structured::reseed). Its
+// subsets grow as J^2 and each round polishes up to J + 1 configurations, so
+// larger searches (W1's 5 terms) skip it.
+constexpr int kReseedTerms = 4;
+
 struct Term {
   Rotation4 R;
   Parameterization p = Parameterization::WiWo;
@@ -131,6 +137,15 @@ class Structured {
   // po: Powell's options for the re-searches.
   void polish(std::vector<Term>& ts, double& value, size_t from, int sweeps, int n, TermRecord* rec,
               const PowellOptions& po);
+  // The terms re-read from the data under the joint objective (all terms
+  // solved together): for every term and every pair of terms, the others'
+  // textures (of the joint fit) are removed from g and that residual's seed
+  // planes, in each parameterization, replace the term or the pair; the
+  // replacement is read again from its own joint fit (alternating seeds and
+  // fits) while that lowers the objective. The best replacement is polished
+  // and kept if the joint objective falls; rounds until nothing moves.
+  // value: the joint objective of ts on return.
+  void reseed(std::vector<Term>& ts, double& value, TermRecord* rec);
   // A k-term answer: its terms, their refit at texture_size and its error.
   struct Answer {
     std::vector<Term> ts;
@@ -468,6 +483,129 @@ void Structured::polish(std::vector<Term>& ts, double& value, size_t from, int s
   rec->seconds += now_seconds() - t0;
 }
 
+void Structured::reseed(std::vector<Term>& ts, double& value, TermRecord* rec) {
+  const double t0 = now_seconds();
+  const size_t J = ts.size();
+  const int n = static_cast<int>(J);
+  std::vector<FactorTerm> done;
+  value = schedule(ts, &done, n);
+  ++evaluations_;
+  ++rec->backfit_evaluations;
+  if (!std::isfinite(value)) return;
+  std::vector<std::vector<size_t>> subsets;
+  for (size_t i = 0; i < J; ++i) subsets.push_back({i});
+  for (size_t i = 0; i < J; ++i)
+    for (size_t k = i + 1; k < J; ++k) subsets.push_back({i, k});
+  PowellOptions fine = opt_.powell;
+  fine.line_tol = 1e-3;
+  fine.initial_step = 0.05;
+  fine.ftol = 1e-6;
+  for (int round = 0; round < 4; ++round) {
+    struct Found {
+      std::vector<Term> ts;
+      double value = kInf;
+      int fits = 0;
+    };
+    std::vector<Found> found(subsets.size());
+    parallel_for(subsets.size(), opt_.threads, [&](size_t si) {
+      const std::vector<size_t>& S = subsets[si];
+      Found& f = found[si];
+      std::vector<Term> cur = ts;
+      std::vector<FactorTerm> cdone = done;
+      double cv = value;
+      for (int it = 0; it < 3; ++it) {
+        std::vector<FactorTerm> others;
+        for (size_t i = 0; i < J; ++i)
+          if (std::find(S.begin(), S.end(), i) == S.end()) others.push_back(cdone[i]);
+        std::vector<Term> best_ts;
+        std::vector<FactorTerm> best_done;
+        double best = kInf;
+        for (const auto& [p, sp] : seeds(residual(others))) {
+          std::vector<std::vector<Term>> trials;
+          if (S.size() == 2) {
+            trials.push_back(cur);
+            trials.back()[S[0]] = Term{sp.first, p};
+            trials.back()[S[1]] = Term{sp.second, p};
+          } else {
+            trials.push_back(cur);
+            trials.back()[S[0]] = Term{sp.first, p};
+            trials.push_back(cur);
+            trials.back()[S[0]] = Term{sp.second, p};
+          }
+          for (std::vector<Term>& t : trials) {
+            std::vector<FactorTerm> td;
+            const double v = schedule(t, &td, n);
+            ++f.fits;
+            if (v < best) {
+              best = v;
+              best_ts = std::move(t);
+              best_done = std::move(td);
+            }
+          }
+        }
+        if (it > 0 && !(best < cv * (1 - 1e-6))) break;
+        cur = std::move(best_ts);
+        cdone = std::move(best_done);
+        cv = best;
+        if (!std::isfinite(cv)) break;
+      }
+      f.ts = cur;
+      f.value = cv;
+    });
+    std::vector<size_t> order(found.size());
+    for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+    std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return found[a].value < found[b].value; });
+    for (const Found& f : found) {
+      evaluations_ += f.fits;
+      rec->backfit_evaluations += f.fits;
+    }
+    // Which replacements are polished: the best one if it is already lower,
+    // and, for every other mix of parameterizations (number of wiwo terms),
+    // its best replacement if it is within 2x of now (a term moved to the
+    // other parameterization starts higher before the others adapt). Each is
+    // polished with one coarse sweep; the lowest, if below now, gets the full
+    // polish (coarse, then fine) and is kept if it stays lower.
+    const auto wiwo_count = [](const std::vector<Term>& t) {
+      int c = 0;
+      for (const Term& x : t) c += x.p == Parameterization::WiWo;
+      return c;
+    };
+    std::vector<size_t> chosen;
+    if (!order.empty() && found[order[0]].value < value * (1 - 1e-6)) chosen.push_back(order[0]);
+    std::vector<int> seen = {wiwo_count(ts)};
+    for (size_t i : order) {
+      const int c = wiwo_count(found[i].ts);
+      if (std::find(seen.begin(), seen.end(), c) != seen.end()) continue;
+      seen.push_back(c);
+      if (found[i].value < 2 * value && std::find(chosen.begin(), chosen.end(), i) == chosen.end())
+        chosen.push_back(i);
+    }
+    for (size_t i : chosen) polish(found[i].ts, found[i].value, 0, 1, n, rec, opt_.powell);
+    bool moved = false;
+    std::vector<Term> best_ts = ts;
+    double best = value;
+    size_t pick = found.size();
+    for (size_t i : chosen)
+      if (found[i].value < value * (1 - 1e-6) && (pick == found.size() || found[i].value < found[pick].value)) pick = i;
+    if (pick < found.size()) {
+      Found& f = found[pick];
+      polish(f.ts, f.value, 0, opt_.polish_sweeps, n, rec, opt_.powell);
+      polish(f.ts, f.value, 0, opt_.polish_sweeps, n, rec, fine);
+      if (f.value < best * (1 - 1e-6)) {
+        best = f.value;
+        best_ts = f.ts;
+        moved = true;
+      }
+    }
+    if (!moved) break;
+    ts = best_ts;
+    value = schedule(ts, &done, n);
+    ++evaluations_;
+    ++rec->backfit_evaluations;
+  }
+  rec->seconds += now_seconds() - t0;
+}
+
 std::shared_ptr<HomomorphicFactorization> Structured::refit(const std::vector<Term>& ts,
                                                             std::vector<double>* errors) const {
   errors->clear();  // fit_homomorphic appends
@@ -600,6 +738,21 @@ SearchResult Structured::run() {
       fine.initial_step = 0.05;
       fine.ftol = 1e-6;
       polish(ts, value, 0, opt_.polish_sweeps, n, &records.back(), fine);
+    }
+  }
+  // Searches of 3..kReseedTerms terms with a parameterization per term: the
+  // terms re-read under the joint objective (reseed), which finds planes the
+  // beam misses when the terms do not share one parameterization.
+  if (J >= 3 && J <= kReseedTerms && opt_.final_joint && params_.size() > 1) {
+    const std::vector<Term> before = ts;
+    double joint = kInf;
+    reseed(ts, joint, &records.back());
+    bool moved = false;
+    for (size_t i = 0; i < ts.size(); ++i)
+      moved = moved || ts[i].p != before[i].p || plane_distance(ts[i].R, before[i].R) > 0;
+    if (moved) {
+      value = n >= J ? joint : schedule(ts, nullptr, n);
+      ++evaluations_;
     }
   }
   const std::vector<Term> answer_ts = fill_answers(ts, stage_best, out);

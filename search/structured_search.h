@@ -27,6 +27,14 @@
 //    polish under that joint objective (the schedule's n = 2 solve cannot
 //    reach McCool's error on a BRDF of exactly McCool's form even at the true
 //    planes).
+//  - re-seeding (searches of 3 or 4 terms, per-term parameterization, with
+//    final_joint): under the joint objective, every term and every pair of
+//    terms is read again from the residual of the others' jointly fitted
+//    textures, in each parameterization (alternating seeds and fits); the best
+//    replacement, and the best of each other mix of parameterizations within
+//    2x, are polished and the lowest kept, rounds until nothing moves. The
+//    beam alone missed planes that do not share a parameterization (a halfdiff
+//    term perturbs the wiwo Hessians and the reverse).
 //  - k-term answers: after term k, every configuration of the beam is refit
 //    at texture_size and the best is stage k's answer; besides the beam, that
 //    answer is extended greedily (its random starts in each parameterization,

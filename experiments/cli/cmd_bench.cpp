@@ -423,7 +423,8 @@ void run_bench_lines(const BenchLinesArgs& a) {
 }
 
 struct BenchPlantedArgs {
-  std::string family = "rotation";  // or "mccool"
+  std::string family = "rotation";  // or "mccool", "mixed"
+  std::string floor = "schedule";   // or "joint" (the mixed family's)
   int count = 8;
   int first = 0;
   int terms = 2;
@@ -443,14 +444,35 @@ struct BenchPlantedArgs {
 void run_bench_planted(const BenchPlantedArgs& a) {
   std::fprintf(stderr, "| member | McCool | greedy | structured | floor | greedy/floor | structured/floor | fits greedy | fits structured | s greedy | s structured |\n");
   std::fprintf(stderr, "|---|---|---|---|---|---|---|---|---|---|---|\n");
+  // The members: (index, terms, parameterization); the mixed family is every
+  // index at 3 and 4 terms, main parameterization wiwo and halfdiff.
+  struct Member {
+    int index, terms;
+    std::string param;
+  };
+  std::vector<Member> members;
   for (int i = a.first; i < a.first + a.count; ++i) {
+    if (a.family != "mixed") members.push_back({i, a.terms, a.param});
+    else
+      for (int t : {3, 4})
+        for (const char* p : {"wiwo", "halfdiff"}) members.push_back({i, t, p});
+  }
+  const bool joint_floor = a.floor == "joint" || a.family == "mixed";
+  for (const Member& m : members) {
+    const int i = m.index;
     const PlantedProductBrdf b = a.family == "mccool"
                                      ? planted_mccool_brdf(i)
-                                     : planted_rotation_brdf(i, a.terms, parse_parameterization(a.param));
+                                     : planted_rotation_brdf(i, m.terms, parse_parameterization(m.param));
     const SampleSet s = sample_grid(b, a.grid);
     FitOptions fo;
     fo.solve_last = a.solve_last;
     const FitData d(s, fo.eps);
+    const int terms = a.family == "mccool" ? 3 : m.terms;
+    // The floor: fit at the true projections, either every term solved
+    // jointly (solve_last = terms) or the schedule's (n = solve_last) in the
+    // best term order.
+    FitOptions ffo = fo;
+    if (joint_floor) ffo.solve_last = std::max(fo.solve_last, terms);
     std::vector<TermSpec> truth = b.specs(a.texture);
     std::sort(truth.begin(), truth.end(), [](const TermSpec& x, const TermSpec& y) {
       return std::lexicographical_compare(x.proj.P.data(), x.proj.P.data() + 8, y.proj.P.data(), y.proj.P.data() + 8);
@@ -458,14 +480,13 @@ void run_bench_planted(const BenchPlantedArgs& a) {
     double floor = std::numeric_limits<double>::infinity();
     do {
       std::vector<double> e;
-      fit_homomorphic(d, truth, fo, "fit", &e);
+      fit_homomorphic(d, truth, ffo, "fit", &e);
       floor = std::min(floor, e.back());
-    } while (std::next_permutation(truth.begin(), truth.end(), [](const TermSpec& x, const TermSpec& y) {
+    } while (!joint_floor && std::next_permutation(truth.begin(), truth.end(), [](const TermSpec& x, const TermSpec& y) {
       return std::lexicographical_compare(x.proj.P.data(), x.proj.P.data() + 8, y.proj.P.data(), y.proj.P.data() + 8);
     }));
     std::vector<double> em;
     fit_homomorphic(d, mccool_terms(a.texture), fo, "mccool", &em);
-    const int terms = a.family == "mccool" ? 3 : a.terms;
     nlohmann::json j;
     j["bench"] = "planted";
     j["brdf"] = b.to_string();
@@ -474,6 +495,7 @@ void run_bench_planted(const BenchPlantedArgs& a) {
     j["terms"] = terms;
     j["mccool"] = em.back();
     j["floor"] = floor;
+    j["floor_kind"] = joint_floor ? "joint" : "schedule";
     double err[2] = {NAN, NAN}, secs[2] = {NAN, NAN};
     int fits[2] = {0, 0};
     const char* names[2] = {"greedy", "structured"};
@@ -483,7 +505,7 @@ void run_bench_planted(const BenchPlantedArgs& a) {
       opt.strategy = names[k];
       // The greedy search reads the planted parameterization (its best case);
       // the structured one chooses per term.
-      if (a.family == "rotation") opt.param = parse_parameterization(a.param);
+      if (a.family != "mccool") opt.param = parse_parameterization(m.param);
       opt.terms = terms;
       opt.fit.solve_last = a.solve_last;
       if (k == 1) {
@@ -767,12 +789,19 @@ void add_bench_planted(CLI::App* bench) {
   auto* planted = bench->add_subcommand(
       "planted", "Planted product BRDFs: McCool, greedy and structured search, floor (fit at the true projections)");
   auto pa = std::make_shared<BenchPlantedArgs>();
-  planted->add_option("--family", pa->family, "rotation (random rotation planes) or mccool (p(wi) q(h) p(wo), 3 terms)")
-      ->check(CLI::IsMember({"rotation", "mccool"}))
+  planted->add_option("--family", pa->family,
+                      "rotation (random rotation planes), mccool (p(wi) q(h) p(wo), 3 terms) or mixed (each member "
+                      "at 3 and 4 terms, main parameterization wiwo and halfdiff, joint floor)")
+      ->check(CLI::IsMember({"rotation", "mccool", "mixed"}))
+      ->capture_default_str();
+  planted->add_option("--floor", pa->floor,
+                      "schedule (fit at the true projections, n = solve_last, best order) or joint (every term "
+                      "solved jointly; the mixed family's)")
+      ->check(CLI::IsMember({"schedule", "joint"}))
       ->capture_default_str();
   planted->add_option("--count", pa->count, "members")->capture_default_str();
   planted->add_option("--first", pa->first, "index of the first member")->capture_default_str();
-  planted->add_option("--terms", pa->terms, "rotation family: 2 or 3 terms")->capture_default_str();
+  planted->add_option("--terms", pa->terms, "rotation family: 2, 3 or 4 terms")->capture_default_str();
   planted->add_option("--parameterization", pa->param, "rotation family: wiwo or halfdiff")->capture_default_str();
   planted->add_option("--grid", pa->grid, "regular res^4 parabolic grid")->capture_default_str();
   planted->add_option("--texture", pa->texture, "texture resolution (search and floor)")->capture_default_str();

@@ -35,6 +35,15 @@ double floor_error(const PlantedProductBrdf& b, const FitData& d, int res) {
   return best;
 }
 
+// The joint floor: fit at the true projections with every term solved jointly.
+double joint_floor_error(const PlantedProductBrdf& b, const FitData& d, int res) {
+  FitOptions fo;
+  fo.solve_last = static_cast<int>(b.terms().size());
+  std::vector<double> e;
+  fit_homomorphic(d, b.specs(res), fo, "fit", &e);
+  return e.back();
+}
+
 // 2 - |P_a P_b^T|_F^2: 0 for the same plane.
 double plane_distance(const Mat24& a, const Mat24& b) { return 2 - (a * b.transpose()).squaredNorm(); }
 
@@ -260,6 +269,45 @@ TEST_CASE("structured search: planted family, both parameterizations, 2 and 3 te
         const SearchResult r = search_factorization(d, structured(terms, 8));
         INFO(b.to_string() << ": floor " << fl << ", structured " << r.rel_mse_after_term.back());
         CHECK(r.rel_mse_after_term.back() <= (terms == 2 ? 2.0 : 3.0) * fl);
+      }
+}
+
+TEST_CASE("planted: the 4-term member has two planes in each parameterization") {
+  const PlantedProductBrdf b = planted_rotation_brdf(0, 4, Parameterization::WiWo);
+  REQUIRE(b.terms().size() == 4);
+  CHECK(b.terms()[0].param == Parameterization::WiWo);
+  CHECK(b.terms()[1].param == Parameterization::WiWo);
+  CHECK(b.terms()[2].param == Parameterization::HalfDiff);
+  CHECK(b.terms()[3].param == Parameterization::HalfDiff);
+  // Each parameterization's two planes are orthogonal (planes of one rotation).
+  CHECK(plane_distance(b.terms()[0].P, b.terms()[1].P) == Approx(2).margin(1e-12));
+  CHECK(plane_distance(b.terms()[2].P, b.terms()[3].P) == Approx(2).margin(1e-12));
+  // The 2- and 3-term members are what they were (the 4-term one draws after them).
+  const PlantedProductBrdf b3 = planted_rotation_brdf(0, 3, Parameterization::WiWo);
+  CHECK(b3.terms().size() == 3);
+  CHECK_THROWS_AS(planted_rotation_brdf(0, 5, Parameterization::WiWo), std::invalid_argument);
+}
+
+TEST_CASE("structured search: mixed planted family ends near the joint floor", "[slow]") {
+  // Two planes in one parameterization and one (3 terms) or two (4 terms) in
+  // the other; 16^4 grid, texture 16. The floor is the fit at all true planes
+  // solved jointly; bounds 2x (3 terms) and 3x (4 terms). Before the joint
+  // re-seeding (Structured::reseed) these members ended 5.5x-30x above it,
+  // but for member 0 (3 terms, wiwo). Member 1 in halfdiff still ends at
+  // 11.9x (3 terms: its halfdiff pair stays mixed) and 11.8x (4 terms: every
+  // term wiwo); docs/search.md "Not done". Left out until the search finds them.
+  for (int i : {0, 1})
+    for (int terms : {3, 4})
+      for (Parameterization p : {Parameterization::WiWo, Parameterization::HalfDiff}) {
+        if (i == 1 && p == Parameterization::HalfDiff) continue;
+        const PlantedProductBrdf b = planted_rotation_brdf(i, terms, p);
+        const SampleSet s = sample_grid(b, 16);
+        const FitData d(s, 1e-5);
+        const double fl = joint_floor_error(b, d, 16);
+        const SearchResult r = search_factorization(d, structured(terms, 16));
+        INFO(b.to_string() << ": joint floor " << fl << ", structured " << r.rel_mse_after_term.back() << " ("
+                           << r.evaluations << " fits)");
+        CHECK(r.rel_mse_after_term.back() <= (terms == 3 ? 2.0 : 3.0) * fl);
       }
 }
 
