@@ -578,8 +578,7 @@ Plan parse_plan(const std::string& text, const std::string& path, const std::vec
                        {"render", plan.experiment.render},
                        {"export", plan.experiment.export_factors},
                        {"scene", plan.scene.identity()},
-                       {"validation", {{"design", "sobol-owen"},
-                                       {"pairs", plan.experiment.validation_pairs},
+                       {"validation", {{"pairs", plan.experiment.validation_pairs},
                                        {"holdout", plan.experiment.holdout},
                                        {"seed", validation_seed(plan.experiment.seed)}}}};
   std::set<std::string> ids;

@@ -45,10 +45,10 @@ struct ExperimentSettings {
   bool render = true;       // per run: sphere picture (original | approximation | error)
   bool export_factors = true;  // per run: factor textures, sidecar, GLSL (config key `export`)
   double metric_eps = 1e-5; // eps of the log transform every method is scored with (docs/design.md §4)
-  // Validation (docs/design.md §4 "validation"): scrambled Sobol pairs over
-  // the whole hemisphere pair scored against the BRDF (0 = none), and the
+  // Validation (docs/design.md §4 "validation"): stratified pairs over the
+  // whole hemisphere pair scored against the BRDF (0 = none), and the
   // fraction of measured/file samples held out of the fit.
-  int validation_pairs = 65536;
+  int validation_pairs = 4096;
   double holdout = 0.1;
 };
 

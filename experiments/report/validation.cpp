@@ -1,9 +1,6 @@
 // Validation sets, held-out samples and flags (see validation.h).
 #include "experiments/report/validation.h"
 
-#include "brdfs/directions.h"
-
-#include <array>
 #include <cmath>
 #include <stdexcept>
 
@@ -19,67 +16,7 @@ uint64_t splitmix(uint64_t& x) {
   return z ^ (z >> 31);
 }
 
-// Direction numbers of the first four Sobol dimensions (degree s, coefficients
-// a, initial m_1..m_s of each primitive polynomial; Joe and Kuo's choice),
-// 32 bits each.
-std::array<std::array<uint32_t, 32>, 4> sobol_directions() {
-  struct Poly {
-    int s;
-    uint32_t a;
-    std::array<uint32_t, 3> m;
-  };
-  const Poly polys[3] = {{1, 0, {1, 0, 0}}, {2, 1, {1, 3, 0}}, {3, 1, {1, 3, 1}}};
-  std::array<std::array<uint32_t, 32>, 4> v{};
-  for (int k = 0; k < 32; ++k) v[0][k] = uint32_t(1) << (31 - k);
-  for (int d = 1; d < 4; ++d) {
-    const Poly& p = polys[d - 1];
-    for (int k = 0; k < 32; ++k) {
-      if (k < p.s) {
-        v[d][k] = p.m[k] << (31 - k);
-        continue;
-      }
-      uint32_t x = v[d][k - p.s] ^ (v[d][k - p.s] >> p.s);
-      for (int i = 1; i < p.s; ++i)
-        if ((p.a >> (p.s - 1 - i)) & 1) x ^= v[d][k - i];
-      v[d][k] = x;
-    }
-  }
-  return v;
-}
-
-// Owen's nested scrambling of a 32-bit coordinate: bit b is flipped by a
-// hash of (key, b, the bits above b), so every elementary interval is
-// permuted at random and the points stay a (t, m, s)-net.
-uint32_t owen_scramble(uint32_t x, uint64_t key) {
-  uint32_t out = 0;
-  for (int b = 31; b >= 0; --b) {
-    const uint64_t above = b == 31 ? 0 : uint64_t(x >> (b + 1));
-    uint64_t h = key ^ (above * 0x9e3779b97f4a7c15ULL) ^ (uint64_t(31 - b) << 58);
-    const uint32_t flip = static_cast<uint32_t>(splitmix(h) >> 63);
-    out |= (((x >> b) & 1u) ^ flip) << b;
-  }
-  return out;
-}
-
 }  // namespace
-
-std::vector<std::array<double, 4>> validation_points(size_t count, uint64_t seed) {
-  static const auto v = sobol_directions();
-  std::array<uint64_t, 4> key{};
-  uint64_t state = seed ^ 0x76a11da7e5eedULL;
-  for (auto& k : key) k = splitmix(state);
-  std::vector<std::array<double, 4>> out(count);
-  for (size_t n = 0; n < count; ++n) {
-    const uint64_t g = n ^ (n >> 1);  // Gray-code order: the first 2^m points are the same set
-    for (int d = 0; d < 4; ++d) {
-      uint32_t x = 0;
-      for (int k = 0; k < 32 && (g >> k) != 0; ++k)
-        if ((g >> k) & 1) x ^= v[d][k];
-      out[n][d] = (double(owen_scramble(x, key[d])) + 0.5) * 0x1p-32;
-    }
-  }
-  return out;
-}
 
 bool holds_out(const SamplingVariant& s, const ExperimentSettings& e) {
   return e.holdout > 0.0 && (s.kind == "measured" || s.kind == "file");
@@ -124,17 +61,8 @@ HoldoutSplit split_holdout(const SampleSet& s, double fraction, uint64_t seed) {
 }
 
 SampleSet validation_set(const Brdf& brdf, int pairs, uint64_t seed) {
-  if (pairs < 1) throw std::invalid_argument("validation_pairs: expected >= 1, found " + std::to_string(pairs));
-  SampleSet v;
-  for (const auto& u : validation_points(static_cast<size_t>(pairs), seed)) {
-    // Dimensions 0 and 1 (the pair with the best joint stratification) are
-    // the two cosines, so the grazing corner gets its share of pairs.
-    v.wi.push_back(from_spherical(std::acos(u[0]), 2.0 * M_PI * u[2]));
-    v.wo.push_back(from_spherical(std::acos(u[1]), 2.0 * M_PI * u[3]));
-  }
-  evaluate_into(brdf, v);
-  v.description = "validation: " + std::to_string(pairs) + " scrambled Sobol pairs (seed " + std::to_string(seed) +
-                  ") over the hemisphere pair";
+  SampleSet v = sample_stratified(brdf, static_cast<size_t>(pairs), seed);
+  v.description = "validation: stratified " + std::to_string(pairs) + " pairs over the hemisphere pair";
   return v;
 }
 

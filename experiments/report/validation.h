@@ -8,7 +8,6 @@
 // its method kind.
 #pragma once
 
-#include <array>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -44,16 +43,10 @@ struct HoldoutSplit {
 };
 HoldoutSplit split_holdout(const SampleSet& s, double fraction, uint64_t seed);
 
-// The whole-domain validation set of a BRDF: `pairs` points of the 4D Sobol
-// sequence with Owen's scrambling (seeded; validation_points) mapped to
-// (cos theta_i, cos theta_o, phi_i, phi_o), uniform in solid angle: every
-// elementary box of the (cos theta_i, cos theta_o) square, including the
-// grazing corner, holds its share of pairs (a Latin hypercube only stratifies
-// each coordinate alone). Deterministic for (pairs, seed).
+// The whole-domain validation set of a BRDF: sample_stratified(brdf, pairs,
+// seed) (Latin-hypercube in cos theta and phi of both directions, uniform in
+// solid angle, so grazing directions are sampled as often as their solid angle).
 SampleSet validation_set(const Brdf& brdf, int pairs, uint64_t seed);
-// The design's points in [0, 1)^4 (validation_set's u: cos theta_i, cos theta_o,
-// phi_i / 2 pi, phi_o / 2 pi), each coordinate uniform.
-std::vector<std::array<double, 4>> validation_points(size_t count, uint64_t seed);
 
 // Scores of one approximation on the validation data.
 struct ValidationScores {

@@ -123,7 +123,7 @@ std::string validation_scheme(const Plan& plan, const BrdfVariant& b, const Samp
                               const HoldoutSplit* split, size_t all_valid) {
   std::vector<std::string> parts;
   if (domain)
-    parts.push_back("domain: " + std::to_string(domain->size()) + " Sobol pairs (seed " +
+    parts.push_back("domain: " + std::to_string(domain->size()) + " stratified pairs (seed " +
                     std::to_string(validation_seed(plan.experiment.seed)) + ") vs the " +
                     (b.measured ? "interpolant" : "BRDF"));
   if (split)
