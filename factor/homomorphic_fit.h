@@ -94,6 +94,8 @@ class FitData {
  public:
   // Throws if s has no valid sample or a channel is all zero (see LogTransform::of).
   FitData(const SampleSet& s, double eps);
+  // Empty; filled member by member by a subset of another FitData (search/subsample.h).
+  FitData() = default;
   size_t size() const { return w.size(); }
 
   LogTransform transform;

@@ -5,6 +5,7 @@
 #include "solvers/parallel.h"
 
 #include "search/structured_search.h"
+#include "search/subsample.h"
 
 #include <nlopt.hpp>
 
@@ -79,6 +80,9 @@ void SearchOptions::validate() const {
   if (std::find(std::begin(kOptimizers), std::end(kOptimizers), optimizer) == std::end(kOptimizers))
     throw OptionError("optimizer", "optimizer: expected powell, praxis, bobyqa, neldermead, sbplx, "
                                 "direct or crs, found \"" + optimizer + "\"");
+  if (search_samples != 0 && search_samples < kMinSearchSamples)
+    throw OptionError("search_samples", "search_samples: expected 0 or \"off\" (search on every sample) or >= " +
+                                std::to_string(kMinSearchSamples) + ", found " + std::to_string(search_samples));
   if (threads < 0)
     throw OptionError("threads", "threads: expected >= 0, found " + std::to_string(threads));
   const int starts = restarts + static_cast<int>(guesses.size());
@@ -428,9 +432,83 @@ SearchResult best_of_both(const FitData& data, const SearchOptions& opt) {
 
 }  // namespace
 
+namespace {
+
+std::vector<TermSpec> specs_of(const HomomorphicFactorization& h) {
+  std::vector<TermSpec> sp;
+  for (const FactorTerm& t : h.terms()) sp.push_back(TermSpec{t.proj, t.reciprocal, t.rotation});
+  return sp;
+}
+
+SearchResult search_on(const FitData& data, const SearchOptions& opt);
+
+// The fit options of a J-term answer's refit at texture_size: the greedy
+// search's schedule; the structured search solves all terms jointly with
+// final_joint (Structured::refit).
+FitOptions refit_options(const SearchOptions& opt, int J) {
+  FitOptions fo = opt.fit;
+  if (opt.strategy == "structured" && opt.final_joint) fo.solve_last = std::max(fo.solve_last, J);
+  return fo;
+}
+
+// h's projections fitted on `data` at texture_size, as the search refits them.
+std::shared_ptr<HomomorphicFactorization> refit_on(const FitData& data, const SearchOptions& opt,
+                                                   const HomomorphicFactorization& h,
+                                                   std::vector<double>* errors) {
+  if (errors) errors->clear();
+  return fit_homomorphic(data, specs_of(h), refit_options(opt, static_cast<int>(h.terms().size())), "search",
+                         errors);
+}
+
+}  // namespace
+
+void refit_search_result(const FitData& data, const SearchOptions& opt, SearchResult& r) {
+  std::vector<double> errors;
+  if (r.answers.empty()) {  // greedy: its k-term answers are the schedule's prefixes
+    r.factorization = refit_on(data, opt, *r.factorization, &errors);
+    r.rel_mse_after_term = errors;
+    return;
+  }
+  // Structured: every k-term answer on its own.
+  for (size_t k = 0; k < r.answers.size(); ++k) {
+    if (!r.answers[k]) continue;
+    r.answers[k] = refit_on(data, opt, *r.answers[k], &errors);
+    r.rel_mse_after_term[k] = errors.back();
+  }
+  r.factorization = r.answers.back();
+}
+
 SearchResult search_factorization(const FitData& data, const SearchOptions& opt) {
   opt.validate();
   if (opt.strategy == "best") return best_of_both(data, opt);
+  if (opt.search_samples == 0 || data.size() <= opt.search_samples) {
+    SearchResult r = search_on(data, opt);
+    r.search_samples = r.data_samples = data.size();
+    return r;
+  }
+  // The candidates on a stratified subsample; the answers refit on every sample.
+  const double t0 = now_seconds();
+  SubsampleInfo info;
+  const FitData sub = stratified_subsample(data, opt.search_samples, opt.seed, &info);
+  SearchOptions so = opt;
+  if (opt.stop_after_term)  // the stopping rule judges the terms so far fitted on every sample
+    so.stop_after_term = [&](const HomomorphicFactorization& h) {
+      return opt.stop_after_term(*refit_on(data, opt, h, nullptr));
+    };
+  SearchResult r = search_on(sub, so);
+  refit_search_result(data, opt, r);
+  r.search_samples = info.samples;
+  r.data_samples = info.of;
+  r.subsample_seed = info.seed;
+  r.subsample_strata = info.strata;
+  r.seconds = now_seconds() - t0;
+  return r;
+}
+
+namespace {
+
+// One strategy (structured or greedy) on the samples given.
+SearchResult search_on(const FitData& data, const SearchOptions& opt) {
   if (opt.strategy == "structured") {
     SearchResult r = structured_search(data, opt);
     r.strategy = "structured";
@@ -510,5 +588,7 @@ SearchResult search_factorization(const FitData& data, const SearchOptions& opt)
   out.seconds = now_seconds() - t0;
   return out;
 }
+
+}  // namespace
 
 }  // namespace bf

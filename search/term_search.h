@@ -34,6 +34,9 @@ namespace bf {
 inline constexpr int kMaxSearchTerms = 64;
 inline constexpr int kMaxRestarts = 100000;
 inline constexpr uint64_t kMaxTotalTexels = uint64_t(1) << 26;  // terms x texture_size^2
+// SearchOptions::search_samples: the default, and the smallest subsample allowed.
+inline constexpr size_t kDefaultSearchSamples = 100000;
+inline constexpr size_t kMinSearchSamples = 1000;
 
 struct SearchOptions {
   // "structured" (structured_search.h: seeds read off the data's Hessians,
@@ -77,6 +80,11 @@ struct SearchOptions {
   // refit at texture_size and passed here; true ends the search with those
   // terms, so later terms are never searched. Empty: all `terms` are built.
   std::function<bool(const HomomorphicFactorization&)> stop_after_term;
+  // Above this many samples the search evaluates its candidates on a
+  // stratified subsample of this many (search/subsample.h, seeded by `seed`);
+  // the final fit at texture_size and the errors use every sample. 0 = off
+  // (every sample). Otherwise >= kMinSearchSamples.
+  size_t search_samples = kDefaultSearchSamples;
   void validate() const;                // throws naming the field, value and rule
 };
 
@@ -108,9 +116,26 @@ struct SearchResult {
   int best_branch = 0;                     // the winning branch (0 = the greedy one)
   int evaluations = 0;                     // all inner-loop fits (all branches, backfitting)
   double seconds = 0;
+  // The samples the search evaluated its candidates on: search_samples of
+  // `data_samples` (equal when every sample was used), drawn with
+  // subsample_seed (0 when not subsampled) from subsample_strata strata.
+  // `terms[].search_rel_mse`, `search_rel_mse` and `beam_rel_mse` are errors
+  // on those samples; `rel_mse_after_term`, `answers` and `factorization` are
+  // fitted on every sample.
+  size_t search_samples = 0;
+  size_t data_samples = 0;
+  uint64_t subsample_seed = 0;
+  size_t subsample_strata = 0;
 };
 
 SearchResult search_factorization(const FitData& data, const SearchOptions& opt);
+
+// Refits r's answers (or, greedy, its factorization) on `data` at
+// texture_size as the search refits them (greedy: the schedule; structured:
+// all terms solved jointly with final_joint), replacing factorization, answers
+// and rel_mse_after_term. What search_factorization does after a search on a
+// subsample; on the samples the search ran on it reproduces r.
+void refit_search_result(const FitData& data, const SearchOptions& opt, SearchResult& r);
 
 // The objective of one candidate rotation for the next term (exposed for
 // benchmarks and tests): rel_mse of fixed + joint with the candidate last.

@@ -239,6 +239,7 @@ struct BenchSearchArgs {
   int keep = SearchOptions{}.keep;
   int polish_sweeps = SearchOptions{}.polish_sweeps;
   int beam_width = SearchOptions{}.beam_width;
+  double perturb = 0;  // relative perturbation of every sample value (rounding robustness)
 };
 
 SearchOptions bench_search_options(const BenchSearchArgs& a, const std::string& strategy) {
@@ -295,6 +296,7 @@ nlohmann::json bench_one_search(const BenchSearchArgs& a, const FitData& d, cons
   j["beam"] = a.beam;
   j["backfit_sweeps"] = a.backfit_sweeps;
   j["backfit_restarts"] = a.backfit_restarts;
+  if (a.perturb != 0) j["perturb"] = a.perturb;
   j["seconds"] = r.seconds;
   j["cpu_seconds"] = cpu;  // process CPU time, all threads
   j["evaluations"] = r.evaluations;
@@ -320,7 +322,15 @@ nlohmann::json bench_one_search(const BenchSearchArgs& a, const FitData& d, cons
 
 void run_bench_search(const BenchSearchArgs& a) {
   const BrdfPtr brdf = Catalogue::builtin().make(a.brdf);
-  const SampleSet s = a.sampling == "measured" ? measured_samples(*brdf) : sample_grid(*brdf, a.grid);
+  SampleSet s = a.sampling == "measured" ? measured_samples(*brdf) : sample_grid(*brdf, a.grid);
+  if (a.perturb != 0) {
+    // Every value times 1 + perturb * u, u uniform in [-1, 1] from a fixed seed:
+    // the same data up to rounding-level noise.
+    std::mt19937_64 rng(0x9e77u);
+    std::uniform_real_distribution<double> U(-1.0, 1.0);
+    for (Rgb& v : s.value)
+      for (int c = 0; c < 3; ++c) v[c] *= 1.0 + a.perturb * U(rng);
+  }
   const FitData d(s, FitOptions{}.eps);
   if (a.strategy != "both") {
     bench_one_search(a, d, a.strategy);
@@ -748,6 +758,11 @@ void add_bench_search(CLI::App* bench) {
   search->add_option("--beam-width", b->beam_width, "structured: configurations kept per step")
       ->capture_default_str();
   search->add_option("--polish-sweeps", b->polish_sweeps, "structured: joint re-search sweeps at the end")
+      ->capture_default_str();
+  search->add_option("--perturb", b->perturb,
+                     "multiply every sample value by 1 + p u, u uniform in [-1, 1] (fixed seed): "
+                     "does the search end in the same place under rounding-level changes?")
+      ->check(CLI::Range(0.0, 0.1))
       ->capture_default_str();
   search->callback([b, search] {
     // As in a config: an explicit --parameterization is every term's (fixed),

@@ -83,7 +83,13 @@ const std::vector<KeySpec>& search_keys() {
         int_key("beam_width", 1, 1000, "8", "structured: partial configurations kept per term"),
         bool_key("final_joint", "true", "structured: the final refit solves all terms jointly"),
         int_key("joint_polish_terms", 0, 64, "3",
-                "structured: searches of up to this many terms pick their last term and polish under the joint fit")};
+                "structured: searches of up to this many terms pick their last term and polish under the joint fit"),
+        other_key("search_samples", "0, `\"off\"` or an integer >= 1000", "100000",
+                  "above this many fit samples the search evaluates its candidates (screening, Powell, polish) on a "
+                  "stratified subsample of this many (strata over θh, φh, θd, φd, a cap per stratum, each stratum's "
+                  "weight kept; seeded by `seed`), and refits its answers at `texture_size` on every sample; every "
+                  "metric uses every sample. 0 or `\"off\"`: every sample. Column `search_samples`, run.json "
+                  "`search_subsample`. docs/search.md \"Search on a subsample\"")};
     k.insert(k.end(), own.begin(), own.end());
     return k;
   }();
@@ -91,6 +97,29 @@ const std::vector<KeySpec>& search_keys() {
 }
 
 const KeySpec& key(const std::string& name) { return find_key(search_keys(), name); }
+
+// search_samples: 0 or "off" (every sample) or a count >= kMinSearchSamples.
+void read_search_samples(Reader& r, SearchOptions& s) {
+  const toml::node* n = r.take("search_samples");
+  if (!n) return;
+  const std::string rule = "expected 0 or \"off\" (search on every sample) or an integer >= " +
+                           std::to_string(kMinSearchSamples) + " (the subsample's size), ";
+  if (auto str = n->as_string()) {
+    if (str->get() == "off") s.search_samples = 0;
+    else r.fail("search_samples", rule + "found \"" + str->get() + "\"");
+    return;
+  }
+  auto v = n->as_integer();
+  if (!v) {
+    r.fail("search_samples", rule + found(*n));
+    return;
+  }
+  if (v->get() != 0 && v->get() < static_cast<int64_t>(kMinSearchSamples)) {
+    r.fail("search_samples", rule + "found " + std::to_string(v->get()));
+    return;
+  }
+  s.search_samples = static_cast<size_t>(v->get());
+}
 
 void read_guesses(Reader& r, SearchOptions& s) {
   const toml::node* g = r.take("guesses");
@@ -135,6 +164,8 @@ void record_options(const MethodVariant& m, json& o) {
   o["max_sweeps"] = s.powell.max_sweeps;
   o["max_evaluations"] = s.powell.max_evaluations;
   o["seed"] = m.seed;
+  // Every strategy: above it the search runs on a subsample (0 = off).
+  o["search_samples"] = s.search_samples;
   // Non-greedy options enter the run id only when set, so greedy runs keep their cache.
   if (s.strategy != "greedy") {
     o["strategy"] = s.strategy;
@@ -193,12 +224,16 @@ class SearchKind final : public HomomorphicKind {
   std::vector<std::string> columns() const override {
     std::vector<std::string> c = homomorphic_columns();
     c.push_back("search_strategy");
+    c.push_back("search_samples");
     return c;
   }
   void fill_row(const RunContext& c, MethodOutcome& out, Row& row) const override {
     fill_homomorphic_row(c, out, row);
     row["parameterization"] = asked_parameterization(homomorphic_options(c.method).search);
     row["search_strategy"] = out.record.value("search_strategy", "");
+    // The samples the search evaluated its candidates on (= samples unless subsampled).
+    const json& sub = out.record.value("search_subsample", json::object());
+    row["search_samples"] = sub.contains("samples") ? std::to_string(sub["samples"].get<size_t>()) : "";
   }
 
   void read(Reader& r, MethodVariant& m, json& o, uint64_t base_seed) const override {
@@ -237,6 +272,7 @@ class SearchKind final : public HomomorphicKind {
     if (s.search_texture_size == 1) r.fail("search_texture_size", "expected 0 (same as texture_size) or 2..1024, found 1");
     s.restarts = static_cast<int>(r.integer(key("restarts"), s.restarts));
     read_guesses(r, s);
+    read_search_samples(r, s);
     h.reciprocity = r.boolean(key("reciprocity"), false);
     s.optimizer = r.choice(key("optimizer"), s.optimizer);
     s.powell.ftol = r.number(key("ftol"), s.powell.ftol);
@@ -311,6 +347,14 @@ class SearchKind final : public HomomorphicKind {
     MethodOutcome out = finish_homomorphic(c, std::move(run), std::move(chosen), sr.evaluations);
     out.record["terms"] = term_records(sr);
     out.record["search_strategy"] = sr.strategy;
+    // What the search's candidates were evaluated on (the final fit and the
+    // metrics use every sample): a stratified subsample above search_samples.
+    out.record["search_subsample"] = {{"threshold", so.search_samples},
+                                      {"samples", sr.search_samples},
+                                      {"of", sr.data_samples},
+                                      {"subsampled", sr.search_samples < sr.data_samples},
+                                      {"seed", sr.subsample_seed},
+                                      {"strata", sr.subsample_strata}};
     json term_params = json::array();
     for (const FactorTerm& t : sr.factorization->terms()) term_params.push_back(to_string(t.proj.param));
     out.record["term_parameterizations"] = term_params;

@@ -45,7 +45,7 @@ const std::vector<std::string>& result_columns() {
   static const std::vector<std::string> c = [] {
     std::vector<std::string> v = required_columns();
     for (const char* e : {"label", "sampling", "sweep", "seed", "status", "errors_after_term",
-                          "search_strategy", "term_parameterizations", "negative_texels",
+                          "search_strategy", "search_samples", "term_parameterizations", "negative_texels",
                           "order", "view_order", "tolerance", "tolerance_reached", "shade_rmse", "scene_rel_mse",
                           "val_rel_mse", "val_cos_rmse", "val_max_ratio", "holdout_rel_mse", "holdout_cos_rmse", "validation",
                           "flag", "isotropic", "symmetries",

@@ -82,6 +82,7 @@ TEST_CASE("run identity: every key that changes results changes the run id") {
       {"method[1].terms=2", 1},
       {"method[1].seed=9", 1},
       {"method[1].restarts=2", 1},
+      {"method[1].search_samples=5000", 1},  // the search runs on a subsample above it
   };
   for (const auto& [define, which] : changing) {
     INFO("-D " << define);

@@ -203,3 +203,20 @@ TEST_CASE("search parameterization: bench search follows the config's rule") {
   CHECK(j.at("term_param") == "fixed");
   CHECK(j.at("term_parameterizations") == nlohmann::json::array({"wiwo", "wiwo"}));
 }
+
+TEST_CASE("search_samples: 0 and off disable the subsample and bad values are refused naming the key") {
+  const std::string head = std::string(kConfigHead) + "[[method]]\nkind = \"search\"\nterms = 1\nsearch_samples = ";
+  for (const char* bad : {"10", "-1", "999", "\"auto\"", "1.5", "true"}) {
+    INFO(bad);
+    require_one_config_error(head + bad + "\n", {"search_samples", "expected 0 or \"off\"", ">= 1000"});
+  }
+  for (const char* ok : {"0", "\"off\"", "1000", "250000"}) {
+    INFO(ok);
+    CHECK(config_errors(head + ok + "\n").empty());
+  }
+  // The key enters the run id (a cached search on every sample is not a subsampled one).
+  const Plan a = parse_plan(head + "0\n", "cfg.toml", {}), b = parse_plan(head + "\"off\"\n", "cfg.toml", {}),
+             c = parse_plan(head + "5000\n", "cfg.toml", {});
+  CHECK(a.runs.at(0).run_id == b.runs.at(0).run_id);
+  CHECK(a.runs.at(0).run_id != c.runs.at(0).run_id);
+}
