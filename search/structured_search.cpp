@@ -743,7 +743,7 @@ SearchResult Structured::run() {
   // Searches of 3..kReseedTerms terms with a parameterization per term: the
   // terms re-read under the joint objective (reseed), which finds planes the
   // beam misses when the terms do not share one parameterization.
-  if (J >= 3 && J <= kReseedTerms && opt_.final_joint && params_.size() > 1) {
+  if (opt_.reseed && J >= 3 && J <= kReseedTerms && opt_.final_joint && params_.size() > 1) {
     const std::vector<Term> before = ts;
     double joint = kInf;
     reseed(ts, joint, &records.back());

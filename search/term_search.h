@@ -60,6 +60,11 @@ struct SearchOptions {
   // Structured, with final_joint: searches of up to this many terms also
   // polish under the joint objective (larger ones polish the schedule's), >= 0.
   int joint_polish_terms = 3;
+  // Structured, terms 3..4, term_param "either", final_joint: re-read the terms
+  // under the joint objective after the polish (structured_search.h,
+  // "re-seeding"); finds planes that do not share a parameterization, at up to
+  // about 3.5x the fits.
+  bool reseed = true;
   int texture_size = 16;                // final texture resolution
   int search_texture_size = 0;          // resolution during the search; 0 = texture_size
   int restarts = 6;                     // seeded random starts per term, >= 0

@@ -82,6 +82,9 @@ const std::vector<KeySpec>& search_keys() {
         int_key("polish_sweeps", 0, 1000, "2", "structured: final sweeps re-searching each term with the others held"),
         int_key("beam_width", 1, 1000, "8", "structured: partial configurations kept per term"),
         bool_key("final_joint", "true", "structured: the final refit solves all terms jointly"),
+        bool_key("reseed", "true",
+                 "structured, 3-4 terms, `term_param = \"either\"`: re-read every term and pair of terms under the "
+                 "joint fit after the polish (finds planes of different parameterizations; up to ~3.5x the fits)"),
         int_key("joint_polish_terms", 0, 64, "3",
                 "structured: searches of up to this many terms pick their last term and polish under the joint fit"),
         other_key("search_samples", "0, `\"off\"` or an integer >= 1000", "100000",
@@ -175,6 +178,7 @@ void record_options(const MethodVariant& m, json& o) {
     o["beam_width"] = s.beam_width;
     o["final_joint"] = s.final_joint;
     o["joint_polish_terms"] = s.joint_polish_terms;
+    o["reseed"] = s.reseed;
   }
   if (s.beam != 1) o["beam"] = s.beam;
   if (s.backfit_sweeps != 0) o["backfit_sweeps"] = s.backfit_sweeps;
@@ -256,6 +260,7 @@ class SearchKind final : public HomomorphicKind {
     s.beam_width = static_cast<int>(r.integer(key("beam_width"), s.beam_width));
     s.final_joint = r.boolean(key("final_joint"), s.final_joint);
     s.joint_polish_terms = static_cast<int>(r.integer(key("joint_polish_terms"), s.joint_polish_terms));
+    s.reseed = r.boolean(key("reseed"), s.reseed);
     h.param = read_param(r, "parameterization", s.param);
     if (param_given && r.has("term_param") && s.term_param == "either")
       r.fail("term_param", "term_param = \"either\" lets the search choose each term's parameterization, which "

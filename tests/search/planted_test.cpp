@@ -320,7 +320,10 @@ TEST_CASE("structured search: McCool's form is inside the search space and survi
   const FitData d(s, 1e-5);
   std::vector<double> em;
   fit_homomorphic(d, mccool_terms(8), FitOptions{}, "mccool", &em);
-  const SearchResult r = search_factorization(d, structured(3, 8));
+  // The re-seeding step (tested on the mixed family) is off: it doubles this test's time.
+  SearchOptions so = structured(3, 8);
+  so.reseed = false;
+  const SearchResult r = search_factorization(d, so);
   INFO("McCool " << em.back() << ", structured " << r.rel_mse_after_term.back() << " (" << r.evaluations
                  << " fits)");
   CHECK(r.rel_mse_after_term.back() <= 3 * em.back());
