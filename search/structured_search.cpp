@@ -65,6 +65,13 @@ void parallel_for(size_t n, int threads, Fn fn) {
   for (auto& th : pool) th.join();
 }
 
+// How many terms of a configuration read the wiwo point (its mix of parameterizations).
+int wiwo_count(const std::vector<Term>& t) {
+  int c = 0;
+  for (const Term& x : t) c += x.p == Parameterization::WiWo;
+  return c;
+}
+
 class Structured {
  public:
   Structured(const FitData& d, const SearchOptions& opt)
@@ -565,11 +572,6 @@ void Structured::reseed(std::vector<Term>& ts, double& value, TermRecord* rec) {
     // other parameterization starts higher before the others adapt). Each is
     // polished with one coarse sweep; the lowest, if below now, gets the full
     // polish (coarse, then fine) and is kept if it stays lower.
-    const auto wiwo_count = [](const std::vector<Term>& t) {
-      int c = 0;
-      for (const Term& x : t) c += x.p == Parameterization::WiWo;
-      return c;
-    };
     std::vector<size_t> chosen;
     if (!order.empty() && found[order[0]].value < value * (1 - 1e-6)) chosen.push_back(order[0]);
     std::vector<int> seen = {wiwo_count(ts)};
