@@ -7,20 +7,16 @@
 #include <string>
 
 #include "factor/lighting.h"
+#include "experiments/common/splitmix.h"
 
 namespace bf {
 
 namespace {
 
-// splitmix64: a small, well-mixed generator; one stream per pixel.
+// splitmix64 (experiments/common/splitmix.h); one stream per pixel.
 struct Rng {
   uint64_t s;
-  uint64_t next() {
-    uint64_t z = (s += 0x9e3779b97f4a7c15ull);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-    return z ^ (z >> 31);
-  }
+  uint64_t next() { return splitmix(s); }
   double uniform() { return static_cast<double>(next() >> 11) * 0x1.0p-53; }  // [0, 1)
 };
 

@@ -6,20 +6,9 @@
 #include <stdexcept>
 
 #include "experiments/report/outputs.h"
+#include "experiments/common/splitmix.h"
 
 namespace bf {
-
-namespace {
-
-// SplitMix64: a portable generator (std::shuffle's algorithm is unspecified).
-uint64_t splitmix(uint64_t& x) {
-  uint64_t z = (x += 0x9e3779b97f4a7c15ULL);
-  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-  return z ^ (z >> 31);
-}
-
-}  // namespace
 
 std::vector<HoldoutSplit> split_folds(const SampleSet& s, int k, uint64_t seed) {
   std::vector<size_t> valid;
