@@ -5,8 +5,27 @@
 #include <stdexcept>
 
 #include "experiments/common/splitmix.h"
+#include "experiments/report/holdout_partition.h"
 
 namespace bf {
+
+HoldoutSplit partition_held(const SampleSet& s, const std::vector<uint8_t>& held) {
+  HoldoutSplit out;
+  const bool weighted = !s.weight.empty();
+  for (size_t k = 0; k < s.size(); ++k) {
+    SampleSet& dst = held[k] ? out.held : out.train;
+    dst.wi.push_back(s.wi[k]);
+    dst.wo.push_back(s.wo[k]);
+    dst.value.push_back(s.value[k]);
+    dst.valid.push_back(s.valid[k]);
+    if (weighted) dst.weight.push_back(s.weight[k]);
+  }
+  out.train.invalid_value = s.invalid_value;
+  out.train.invalid_horizon = s.invalid_horizon;
+  out.train.invalid_weight = s.invalid_weight;
+  out.train.symmetries = out.held.symmetries = s.symmetries;
+  return out;
+}
 
 bool holds_out(const SamplingVariant& s, const ExperimentSettings& e) {
   return e.holdout > 0.0 && (s.kind == "measured" || s.kind == "file");
@@ -31,20 +50,7 @@ HoldoutSplit split_holdout(const SampleSet& s, double fraction, uint64_t seed) {
   }
   std::vector<uint8_t> is_held(s.size(), 0);
   for (size_t i = 0; i < n_held; ++i) is_held[valid[i]] = 1;
-  HoldoutSplit out;
-  const bool weighted = !s.weight.empty();
-  for (size_t k = 0; k < s.size(); ++k) {
-    SampleSet& dst = is_held[k] ? out.held : out.train;
-    dst.wi.push_back(s.wi[k]);
-    dst.wo.push_back(s.wo[k]);
-    dst.value.push_back(s.value[k]);
-    dst.valid.push_back(s.valid[k]);
-    if (weighted) dst.weight.push_back(s.weight[k]);
-  }
-  out.train.invalid_value = s.invalid_value;
-  out.train.invalid_horizon = s.invalid_horizon;
-  out.train.invalid_weight = s.invalid_weight;
-  out.train.symmetries = out.held.symmetries = s.symmetries;
+  HoldoutSplit out = partition_held(s, is_held);
   out.train.description = s.description + " without " + std::to_string(n_held) + " held-out samples";
   out.held.description = std::to_string(n_held) + " held-out samples of " + s.description;
   return out;

@@ -7,6 +7,7 @@
 
 #include "experiments/report/outputs.h"
 #include "experiments/common/splitmix.h"
+#include "experiments/report/holdout_partition.h"
 
 namespace bf {
 
@@ -35,21 +36,11 @@ std::vector<HoldoutSplit> split_folds(const SampleSet& s, int k, uint64_t seed) 
   std::vector<int> fold_of(s.size(), -1);
   for (size_t i = 0; i < n; ++i) fold_of[valid[i]] = static_cast<int>(i % static_cast<size_t>(k));
   std::vector<HoldoutSplit> out(static_cast<size_t>(k));
-  const bool weighted = !s.weight.empty();
   for (int f = 0; f < k; ++f) {
+    std::vector<uint8_t> held(s.size(), 0);
+    for (size_t i = 0; i < s.size(); ++i) held[i] = fold_of[i] == f;
     HoldoutSplit& h = out[static_cast<size_t>(f)];
-    for (size_t i = 0; i < s.size(); ++i) {
-      SampleSet& dst = fold_of[i] == f ? h.held : h.train;
-      dst.wi.push_back(s.wi[i]);
-      dst.wo.push_back(s.wo[i]);
-      dst.value.push_back(s.value[i]);
-      dst.valid.push_back(s.valid[i]);
-      if (weighted) dst.weight.push_back(s.weight[i]);
-    }
-    h.train.invalid_value = s.invalid_value;
-    h.train.invalid_horizon = s.invalid_horizon;
-    h.train.invalid_weight = s.invalid_weight;
-    h.train.symmetries = h.held.symmetries = s.symmetries;
+    h = partition_held(s, held);
     const std::string name = "fold " + std::to_string(f + 1) + " of " + std::to_string(k);
     h.train.description = s.description + " without " + name + " (" + std::to_string(h.held.size()) + " samples)";
     h.held.description = name + " of " + s.description;
