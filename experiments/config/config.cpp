@@ -51,7 +51,7 @@ const std::map<std::string, std::vector<std::string>>& key_table() {
       {"top", {"experiment", "brdf", "sampling", "method", "scene"}},
       {"experiment", {"name", "seed", "out", "description", "jobs", "plots", "render", "export",
                       "metric_eps", "validation_pairs", "holdout", "folds"}},
-      {"sampling", {"kind", "resolution", "count", "seed", "path", "zip", "symmetries", "weights"}},
+      {"sampling", {"kind", "resolution", "count", "seed", "path", "zip", "symmetries", "weights", "fill"}},
       {"scene", {"shade_rmse", "light", "intensity", "size", "environment", "environment_eps", "lighting_order",
                  "lighting_nodes"}},
       {"brdf", {"preset", "model", "file", "name", "zip"}},
@@ -309,6 +309,26 @@ std::vector<std::string> sampling_keys_of(const std::string& kind) {
   return {};
 }
 
+// sampling.fill of kind "measured": "auto" (-1), "off" (0) or a share in
+// (0, 0.9]; in the identity (results depend on it), in the label when set.
+void read_fill(Reader& r, SamplingVariant& s) {
+  if (const toml::node* n = r.combo().count("fill") ? r.combo().at("fill") : nullptr; n && n->is_string()) {
+    const std::string v = r.choice("fill", "auto", {"auto", "off"});
+    s.fill = v == "off" ? 0.0 : -1.0;
+  } else if (n) {
+    s.fill = r.number("fill", -1.0, 0.0, 0.9);
+    if (s.fill == 0.0) s.fill = 0.0;
+  }
+  if (s.fill < 0) {
+    s.identity["fill"] = "auto";
+  } else {
+    s.identity["fill"] = s.fill;
+    s.label += s.fill == 0 ? std::string(" fill off") : " fill " + fmt_num(s.fill);
+  }
+  if (s.fill != 0) s.identity["fill_pairs"] = kFillPairs;
+  if (s.fill < 0) s.identity["fill_share"] = kFillShare;
+}
+
 void read_samplings(const toml::node* node, Ctx& ctx, uint64_t base_seed,
                     std::vector<SamplingVariant>& out) {
   std::vector<const toml::table*> tables;
@@ -406,6 +426,15 @@ void read_samplings(const toml::node* node, Ctx& ctx, uint64_t base_seed,
         s.weights = r.choice("weights", "auto", {"auto", "measure", "none"});
         s.identity["weights"] = s.weights;
         if (s.weights != "auto") s.label += " weights " + s.weights;
+      }
+      // The whole-domain fill of raw samples (experiments/run/symmetry_prep.h):
+      // "auto", "off" or a share of the fit's weight in (0, 0.9].
+      if (r.has("fill") && s.kind != "measured") {
+        r.fail("fill", "applies to kind = \"measured\" only (a measured BRDF's interpolant fills the domain), "
+                       "found kind = \"" + s.kind + "\"");
+        r.take("fill");
+      } else if (s.kind == "measured") {
+        read_fill(r, s);
       }
       for (const auto& key : {"resolution", "count", "seed", "path"}) {
         if (!r.has(key) || contains(sampling_keys_of(s.kind), key)) continue;

@@ -49,6 +49,10 @@ uint64_t validation_seed(uint64_t experiment_seed) {
   return std::stoull(content_hash("validation:" + std::to_string(experiment_seed)).substr(0, 12), nullptr, 16);
 }
 
+uint64_t fill_seed(uint64_t experiment_seed) {
+  return std::stoull(content_hash("fill:" + std::to_string(experiment_seed)).substr(0, 12), nullptr, 16);
+}
+
 
 // ------------------------------------------------------------------ keys
 

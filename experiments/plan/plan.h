@@ -60,6 +60,9 @@ struct ExperimentSettings {
 // The seed of the validation set and of the held-out choice, derived from
 // experiment.seed (independent of every sampling and method seed).
 uint64_t validation_seed(uint64_t experiment_seed);
+// The seed of the whole-domain fill's pairs (symmetry_prep.h): unrelated to
+// the validation set's, so the fill never samples the validation pairs.
+uint64_t fill_seed(uint64_t experiment_seed);
 
 // [scene]: the picture of every run and the shade_rmse column (docs/design.md
 // §4), with the defaults below when the config has no [scene] (the default
@@ -99,6 +102,11 @@ inline constexpr OrbitOptions kRunOrbit{2, 2'000'000};
 // its orbit copies share the rest. Without it the fit spends its capacity off
 // the measured slice and the held-out error rises (docs/design.md §4.3).
 inline constexpr double kRawShare = 0.5;
+// The whole-domain fill of raw samples (experiments/run/symmetry_prep.h,
+// docs/design.md §4.5): kFillPairs stratified pairs of the training samples'
+// interpolant carrying kFillShare of the fit's weight ("auto").
+inline constexpr size_t kFillPairs = 8192;
+inline constexpr double kFillShare = 0.3;
 // Both, as they enter a sampling's identity (run ids) when an orbit may be used.
 inline nlohmann::json orbit_identity() {
   return {{"max_rotations", kRunOrbit.max_rotations}, {"budget", kRunOrbit.budget}, {"raw_share", kRawShare}};
@@ -114,6 +122,10 @@ struct SamplingVariant {
   // measured: "auto" (= "measure" for a MERL table, "none" otherwise) | "measure"
   // (each table cell weighted by the hemisphere-pair measure it stands for) | "none".
   std::string weights = "auto";
+  // measured: the whole-domain fill (experiments/run/symmetry_prep.h, docs/design.md
+  // §4.5): -1 = "auto" (kFillShare when the samples' interpolant holds over the
+  // whole domain and they are scattered), 0 = "off", else the fill's share of the fit's weight.
+  double fill = -1.0;
   std::string label;        // "grid 16^4", "stratified 20000 seed 1", "file x.csv", "measured"
   std::string where;
   nlohmann::json identity;  // kind + parameters (+ file digest)

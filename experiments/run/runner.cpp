@@ -251,13 +251,15 @@ HeldOutStage held_out_stage(const Plan& plan, const PlannedRun& pr, const Method
   // preparation as the run's own fit: symmetries, the training-only BRDF of
   // the tabulating kinds, scene weights), scored on them.
   auto held_out_score = [&](const HoldoutSplit& h, const MethodVariant& mv) {
-    const SampleSet view = fit_set(h.train, sym, nullptr);
     const LogTransform flt = LogTransform::of(h.train, plan.experiment.metric_eps);
     BrdfVariant fb = b;
 #ifdef BF_RUNNER_HAVE_MEASURED
     if (b.measured)
       if (BrdfPtr t = measured_from_training(*b.brdf, h.train)) fb.brdf = std::move(t);
 #endif
+    const SampleSet view = with_fill(fit_set(h.train, sym, nullptr),
+                                     choose_fill(plan.samplings[pr.sampling], b.measured ? fb.brdf.get() : nullptr,
+                                                 fill_seed(plan.experiment.seed)));
     std::optional<SampleSet> wv;
     if (const auto wf = mv.options.find("weight_fit"); wf != mv.options.end())
       wv = scene_weighted(view, scene_pairs(*b.brdf, plan.scene), wf->at("floor").get<double>());
@@ -357,7 +359,18 @@ RunEntry execute_run(const Plan& plan, const PlannedRun& pr, const SampleSet& sa
   // sample's orbit; metrics and the held-out split stay on the raw samples.
   const SymmetryChoice sym = choose_symmetries(plan.samplings[pr.sampling], samples);
   OrbitInfo orbit;
-  const SampleSet fit_view = fit_set(fit_samples, sym, &orbit);
+  // Kinds that tabulate the BRDF (svd, sh-k, sh-r) see a measured BRDF made of
+  // the training samples only, so their held-out columns are on unseen data;
+  // the whole-domain fill reads the same training-only BRDF.
+  BrdfVariant fit_b = b;
+#ifdef BF_RUNNER_HAVE_MEASURED
+  if (split && b.measured)
+    if (BrdfPtr t = measured_from_training(*b.brdf, split->train)) fit_b.brdf = std::move(t);
+#endif
+  const FillChoice fill = choose_fill(plan.samplings[pr.sampling], b.measured ? fit_b.brdf.get() : nullptr,
+                                      fill_seed(plan.experiment.seed));
+  const SampleSet fit_view = with_fill(fit_set(fit_samples, sym, &orbit), fill);
+  if (plan.samplings[pr.sampling].kind == "measured") rec["fill"] = fill.describe();
   row["symmetries"] = sym.used.to_string();
   rec["symmetries"] = {{"key", sym.key}, {"declared", sym.declared.to_string()}, {"used", sym.used.to_string()}};
   if (sym.used.any()) rec["symmetries"]["orbit"] = orbit.describe();
@@ -376,13 +389,6 @@ RunEntry execute_run(const Plan& plan, const PlannedRun& pr, const SampleSet& sa
                                            use_folds ? &folds : nullptr, split ? &*split : nullptr, rec);
   const std::optional<FoldSummary>& fold_summary = held.folds;
 
-  // Kinds that tabulate the BRDF (svd, sh-k, sh-r) see a measured BRDF made of
-  // the training samples only, so their held-out columns are on unseen data.
-  BrdfVariant fit_b = b;
-#ifdef BF_RUNNER_HAVE_MEASURED
-  if (split && b.measured)
-    if (BrdfPtr t = measured_from_training(*b.brdf, split->train)) fit_b.brdf = std::move(t);
-#endif
   // Scene-weighted fits (experiments/report/scene_weights.h): the kind fits the
   // weighted samples; rel_mse and the other metrics stay unweighted.
   std::optional<SampleSet> weighted;

@@ -1,5 +1,13 @@
 #include "experiments/run/symmetry_prep.h"
 
+#include <cmath>
+#include <stdexcept>
+
+#if __has_include("brdfs/measured.h")
+#include "brdfs/measured.h"
+#define BF_HAVE_MEASURED 1
+#endif
+
 namespace bf {
 
 SymmetryChoice choose_symmetries(const SamplingVariant& s, const SampleSet& samples) {
@@ -38,6 +46,60 @@ SampleSet fit_set(const SampleSet& train, const SymmetryChoice& c, OrbitInfo* in
   out.validate();
   if (info) info->samples_out = out.size();
   return out;
+}
+
+nlohmann::json FillChoice::describe() const {
+  if (!truth) return {{"used", false}, {"why", why}};
+  return {{"used", true}, {"share", share}, {"pairs", pairs}, {"seed", seed}, {"truth", truth->to_string()}};
+}
+
+FillChoice choose_fill(const SamplingVariant& s, const Brdf* training, uint64_t seed) {
+  FillChoice f;
+  if (s.kind != "measured" || s.fill == 0.0) {
+    f.why = s.kind != "measured" ? "not raw measured samples" : "fill = \"off\"";
+    return f;
+  }
+  std::string why = "no measured BRDF made of the training samples";
+  const bool whole = training && training->whole_domain(&why);
+#ifdef BF_HAVE_MEASURED
+  const bool scattered = training && dynamic_cast<const MeasuredBrdf*>(training) != nullptr;
+#else
+  const bool scattered = false;
+#endif
+  if (s.fill < 0.0) {
+    if (!whole || !scattered) {
+      f.why = !whole ? why : "a table whose cells cover the domain (fill = \"auto\" fills scattered samples only)";
+      return f;
+    }
+    f.share = kFillShare;
+  } else {
+    if (!whole)
+      throw std::invalid_argument(s.where + ": sampling.fill: expected a measured BRDF whose interpolant holds "
+                                  "over the whole domain, found: " + why + " (use fill = \"off\" or \"auto\")");
+    f.share = s.fill;
+  }
+  f.truth = training;
+  f.pairs = kFillPairs;
+  f.seed = seed;
+  return f;
+}
+
+SampleSet with_fill(SampleSet fit, const FillChoice& f) {
+  if (!f.truth) return fit;
+  double total = 0.0;
+  for (size_t k = 0; k < fit.size(); ++k)
+    if (fit.valid[k]) total += fit.weight_of(k);
+  const SampleSet pairs = sample_stratified(*f.truth, f.pairs, f.seed);
+  const size_t n = pairs.valid_count();
+  if (n == 0 || !(total > 0.0)) return fit;
+  // The fill's pairs carry `share` of the final total: w n = share (total + w n).
+  const double w = f.share / (1.0 - f.share) * total / double(n);
+  for (size_t k = 0; k < pairs.size(); ++k)
+    if (pairs.valid[k]) fit.push(pairs.wi[k], pairs.wo[k], pairs.value[k], w);
+  fit.description += "; whole-domain fill: " + std::to_string(n) + " pairs of the training interpolant at " +
+                     std::to_string(static_cast<int>(std::lround(f.share * 100))) + "% of the weight";
+  fit.validate();
+  return fit;
 }
 
 }  // namespace bf

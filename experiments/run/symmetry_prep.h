@@ -38,4 +38,28 @@ SymmetryChoice choose_symmetries(const SamplingVariant& s, const SampleSet& samp
 // expansion (samples_out counts both parts).
 SampleSet fit_set(const SampleSet& train, const SymmetryChoice& c, OrbitInfo* info);
 
+// The whole-domain fill (docs/design.md §4.5). Raw samples cover part of the
+// domain; the whole-domain truth there is their interpolant, which extends
+// the nearest measurements. The fill appends `pairs` stratified pairs (seed)
+// of `truth`, the interpolant of the TRAINING samples only (never of held-out
+// ones), at `share` of the fit set's total weight, so the fit follows that
+// extension where nothing was measured instead of its smoothing alone.
+struct FillChoice {
+  const Brdf* truth = nullptr;  // nullptr: no fill
+  double share = 0.0;
+  size_t pairs = 0;
+  uint64_t seed = 0;
+  std::string why;              // when there is no fill: why (for the record)
+  nlohmann::json describe() const;
+};
+// The sampling's `fill` (plan.h: -1 auto, 0 off, else a share) for a run
+// whose training BRDF is `training` (the measured BRDF made of the training
+// samples, or nullptr). "auto" fills (kFillShare) only scattered samples
+// (brdfs/measured.h MeasuredBrdf) whose interpolant holds over the whole
+// domain; a share the user set needs a training BRDF that holds over the
+// whole domain, else std::invalid_argument naming sampling.fill.
+FillChoice choose_fill(const SamplingVariant& s, const Brdf* training, uint64_t seed);
+// `fit` followed by the fill's pairs (fit itself when there is none).
+SampleSet with_fill(SampleSet fit, const FillChoice& f);
+
 }  // namespace bf

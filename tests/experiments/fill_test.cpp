@@ -1,0 +1,136 @@
+// The whole-domain fill of raw samples (experiments/run/symmetry_prep.h,
+// docs/design.md §4.5): the key, what it appends, where "auto" applies, and
+// what it does to a run on real measured samples.
+#include <set>
+
+#include "brdfs/catalogue.h"
+#include "brdfs/measured.h"
+#include "experiments/report/outputs.h"
+#include "experiments/report/validation.h"
+#include "experiments/run/symmetry_prep.h"
+#include "experiments_helpers.h"
+
+using namespace bf;
+using namespace bf_test;
+
+namespace {
+
+std::string config(const std::string& sampling, const std::string& method, const std::string& extra = "") {
+  return "[experiment]\nseed = 3\nplots = false\nrender = false\nexport = false\nvalidation_pairs = 1024\n" +
+         extra + "[[brdf]]\nmodel = \"krylon-blue\"\n[sampling]\n" + sampling + "\n[[method]]\n" + method + "\n";
+}
+
+// Scattered samples of an isotropic model over the whole domain, declaring all three symmetries.
+std::shared_ptr<MeasuredBrdf> declared_interpolant(bool declare) {
+  SampleSet s = sample_stratified(*Catalogue::builtin().make("cook-torrance"), 600, 4);
+  if (declare) s.symmetries = Symmetries::all();
+  return std::make_shared<MeasuredBrdf>("planted", s, MeasuredOptions{});
+}
+
+SamplingVariant measured_sampling(double fill) {
+  SamplingVariant s;
+  s.kind = "measured";
+  s.fill = fill;
+  s.where = "cfg.toml:7";
+  return s;
+}
+
+}  // namespace
+
+TEST_CASE("fill: the key applies to measured sets only and bad values name the key") {
+  require_one_config_error("[experiment]\nname = \"t\"\n[[brdf]]\npreset = \"bluepaint\"\n[sampling]\nkind = "
+                           "\"grid\"\nresolution = 6\nfill = 0.3\n[[method]]\nkind = \"mccool\"\n",
+                           {"sampling.fill", "measured", "grid"});
+  require_one_config_error(config("kind = \"measured\"\nfill = 0.95", "kind = \"mccool\""),
+                           {"sampling.fill", "0.9", "0.95"});
+  require_one_config_error(config("kind = \"measured\"\nfill = \"always\"", "kind = \"mccool\""),
+                           {"sampling.fill", "always", "auto"});
+}
+
+TEST_CASE("fill: the key and its constants are part of a measured sampling's identity") {
+  register_loaders();
+  const auto identity = [](const std::string& sampling) {
+    return parse_plan(config(sampling, "kind = \"mccool\"\ntexture_size = 4"), "cfg.toml", {}).samplings.at(0);
+  };
+  const SamplingVariant a = identity("kind = \"measured\"");
+  CHECK(a.fill < 0);
+  CHECK(a.identity.at("fill") == "auto");
+  CHECK(a.identity.at("fill_pairs") == kFillPairs);
+  CHECK(a.identity.at("fill_share") == kFillShare);
+  const SamplingVariant off = identity("kind = \"measured\"\nfill = \"off\"");
+  CHECK(off.fill == 0.0);
+  CHECK_FALSE(off.identity.contains("fill_pairs"));
+  const SamplingVariant half = identity("kind = \"measured\"\nfill = 0.5");
+  CHECK(half.fill == 0.5);
+  CHECK(half.identity.at("fill") == 0.5);
+  CHECK(short_hash(a.identity) != short_hash(off.identity));
+  CHECK(short_hash(a.identity) != short_hash(half.identity));
+}
+
+TEST_CASE("fill: the training interpolant's pairs carry exactly the share of the weight") {
+  const auto truth = declared_interpolant(true);
+  const FillChoice f = choose_fill(measured_sampling(-1.0), truth.get(), 77);
+  REQUIRE(f.truth == truth.get());
+  CHECK(f.share == kFillShare);
+  CHECK(f.pairs == kFillPairs);
+  SampleSet fit = sample_stratified(*Catalogue::builtin().make("lambert"), 50, 9);
+  fit.weight.assign(fit.size(), 2.0);  // total 100
+  const SampleSet out = with_fill(fit, f);
+  REQUIRE(out.size() == 50 + kFillPairs);
+  REQUIRE(out.weight.size() == out.size());
+  double filled = 0, total = 0;
+  for (size_t k = 0; k < out.size(); ++k) {
+    total += out.weight_of(k);
+    if (k >= 50) filled += out.weight_of(k);
+  }
+  CHECK(filled / total == Approx(kFillShare).epsilon(1e-12));
+  for (size_t k = 0; k < 50; ++k) CHECK(out.weight_of(k) == 2.0);  // the fit's own samples untouched
+  for (size_t k = 50; k < out.size(); k += 997)
+    CHECK((out.value[k] - truth->eval(out.wi[k], out.wo[k])).abs().maxCoeff() == 0.0);
+  // The fill never samples the whole-domain validation pairs of the same experiment seed.
+  const FillChoice g = choose_fill(measured_sampling(-1.0), truth.get(), fill_seed(3));
+  const SampleSet pairs = with_fill(SampleSet{}, g);
+  const SampleSet val = validation_set(*truth, 1024, validation_seed(3));
+  std::set<std::pair<double, double>> seen;
+  for (size_t k = 0; k < val.size(); ++k) seen.insert({val.wi[k].x(), val.wo[k].y()});
+  size_t shared = 0;
+  for (size_t k = 0; k < pairs.size(); ++k) shared += seen.count({pairs.wi[k].x(), pairs.wo[k].y()});
+  CHECK(shared == 0);
+  CHECK(fill_seed(3) != validation_seed(3));
+}
+
+TEST_CASE("fill: auto leaves undeclared samples alone and a share set there is refused naming the key") {
+  const auto undeclared = declared_interpolant(false);
+  const FillChoice a = choose_fill(measured_sampling(-1.0), undeclared.get(), 1);
+  CHECK(a.truth == nullptr);
+  CHECK_THAT(a.why, Catch::Contains("declare"));
+  CHECK(choose_fill(measured_sampling(-1.0), nullptr, 1).truth == nullptr);
+  CHECK(choose_fill(measured_sampling(0.0), declared_interpolant(true).get(), 1).truth == nullptr);
+  CHECK_THROWS_WITH(choose_fill(measured_sampling(0.3), undeclared.get(), 1),
+                    Catch::Contains("cfg.toml:7") && Catch::Contains("sampling.fill") && Catch::Contains("declare"));
+  // A set share on a BRDF that holds is used as given.
+  CHECK(choose_fill(measured_sampling(0.5), declared_interpolant(true).get(), 1).share == 0.5);
+}
+
+TEST_CASE("fill: on raw Cornell samples the fit follows the interpolant off the measured slice") {
+  ScratchDir tmp;
+  const std::string mccool = "kind = \"mccool\"\ntexture_size = 16";
+  const std::string extra = "holdout = 0.1\n";
+  run_quiet(write_text(tmp / "on.toml", config("kind = \"measured\"", mccool, extra)), tmp / "on");
+  run_quiet(write_text(tmp / "off.toml", config("kind = \"measured\"\nfill = \"off\"", mccool, extra)), tmp / "off");
+  const Row on = read_results_csv(tmp / "on/results.csv").at(0);
+  const Row off = read_results_csv(tmp / "off/results.csv").at(0);
+  INFO("val " << on.at("val_rel_mse") << " vs " << off.at("val_rel_mse") << ", held-out " << on.at("holdout_rel_mse")
+              << " vs " << off.at("holdout_rel_mse"));
+  CHECK(on.at("samples") == off.at("samples"));  // training metrics stay on the raw samples
+  CHECK(std::stod(on.at("val_rel_mse")) < 0.7 * std::stod(off.at("val_rel_mse")));
+  CHECK(std::stod(on.at("holdout_rel_mse")) < 1.25 * std::stod(off.at("holdout_rel_mse")));
+  const nlohmann::json rec = nlohmann::json::parse(read_text(tmp / ("on/runs/" + on.at("run_id") + "/run.json")));
+  CHECK(rec.at("fill").at("used") == true);
+  CHECK(rec.at("fill").at("pairs") == kFillPairs);
+  CHECK(rec.at("fill").at("share") == kFillShare);
+  const nlohmann::json rec_off =
+      nlohmann::json::parse(read_text(tmp / ("off/runs/" + off.at("run_id") + "/run.json")));
+  CHECK(rec_off.at("fill").at("used") == false);
+  CHECK_THAT(rec_off.at("fill").at("why").get<std::string>(), Catch::Contains("off"));
+}
