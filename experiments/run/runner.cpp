@@ -258,7 +258,7 @@ HeldOutStage held_out_stage(const Plan& plan, const PlannedRun& pr, const Method
       if (BrdfPtr t = measured_from_training(*b.brdf, h.train)) fb.brdf = std::move(t);
 #endif
     const SampleSet view = with_fill(fit_set(h.train, sym, nullptr),
-                                     choose_fill(plan.samplings[pr.sampling], b.measured ? fb.brdf.get() : nullptr,
+                                     choose_fill(plan.samplings[pr.sampling], b.measured ? fb.brdf.get() : nullptr, sym,
                                                  fill_seed(plan.experiment.seed)));
     std::optional<SampleSet> wv;
     if (const auto wf = mv.options.find("weight_fit"); wf != mv.options.end())
@@ -367,7 +367,7 @@ RunEntry execute_run(const Plan& plan, const PlannedRun& pr, const SampleSet& sa
   if (split && b.measured)
     if (BrdfPtr t = measured_from_training(*b.brdf, split->train)) fit_b.brdf = std::move(t);
 #endif
-  const FillChoice fill = choose_fill(plan.samplings[pr.sampling], b.measured ? fit_b.brdf.get() : nullptr,
+  const FillChoice fill = choose_fill(plan.samplings[pr.sampling], b.measured ? fit_b.brdf.get() : nullptr, sym,
                                       fill_seed(plan.experiment.seed));
   const SampleSet fit_view = with_fill(fit_set(fit_samples, sym, &orbit), fill);
   if (plan.samplings[pr.sampling].kind == "measured") rec["fill"] = fill.describe();

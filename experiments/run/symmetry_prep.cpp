@@ -53,7 +53,7 @@ nlohmann::json FillChoice::describe() const {
   return {{"used", true}, {"share", share}, {"pairs", pairs}, {"seed", seed}, {"truth", truth->to_string()}};
 }
 
-FillChoice choose_fill(const SamplingVariant& s, const Brdf* training, uint64_t seed) {
+FillChoice choose_fill(const SamplingVariant& s, const Brdf* training, const SymmetryChoice& sym, uint64_t seed) {
   FillChoice f;
   if (s.kind != "measured" || s.fill == 0.0) {
     f.why = s.kind != "measured" ? "not raw measured samples" : "fill = \"off\"";
@@ -67,8 +67,11 @@ FillChoice choose_fill(const SamplingVariant& s, const Brdf* training, uint64_t 
   const bool scattered = false;
 #endif
   if (s.fill < 0.0) {
-    if (!whole || !scattered) {
-      f.why = !whole ? why : "a table whose cells cover the domain (fill = \"auto\" fills scattered samples only)";
+    if (!whole || !scattered || !sym.used.any()) {
+      f.why = !whole       ? why
+              : !scattered ? "a table whose cells cover the domain (fill = \"auto\" fills scattered samples only)"
+                           : "the fit uses no symmetries (symmetries = \"" + sym.key +
+                                 "\"): fill = \"auto\" fills only fits of the samples' orbit";
       return f;
     }
     f.share = kFillShare;

@@ -54,11 +54,13 @@ struct FillChoice {
 };
 // The sampling's `fill` (plan.h: -1 auto, 0 off, else a share) for a run
 // whose training BRDF is `training` (the measured BRDF made of the training
-// samples, or nullptr). "auto" fills (kFillShare) only scattered samples
-// (brdfs/measured.h MeasuredBrdf) whose interpolant holds over the whole
-// domain; a share the user set needs a training BRDF that holds over the
+// samples, or nullptr) and whose fit uses the symmetries `sym`. "auto" fills
+// (kFillShare) only scattered samples (brdfs/measured.h MeasuredBrdf) whose
+// interpolant holds over the whole domain, and only when the fit uses their
+// symmetries (with symmetries = "off" the fit sees the records alone, as the
+// thesis's); a share the user set needs a training BRDF that holds over the
 // whole domain, else std::invalid_argument naming sampling.fill.
-FillChoice choose_fill(const SamplingVariant& s, const Brdf* training, uint64_t seed);
+FillChoice choose_fill(const SamplingVariant& s, const Brdf* training, const SymmetryChoice& sym, uint64_t seed);
 // `fit` followed by the fill's pairs (fit itself when there is none).
 SampleSet with_fill(SampleSet fit, const FillChoice& f);
 

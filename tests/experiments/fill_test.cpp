@@ -27,6 +27,8 @@ std::shared_ptr<MeasuredBrdf> declared_interpolant(bool declare) {
   return std::make_shared<MeasuredBrdf>("planted", s, MeasuredOptions{});
 }
 
+const SymmetryChoice kOrbit{Symmetries::all(), Symmetries::all(), "auto"};
+
 SamplingVariant measured_sampling(double fill) {
   SamplingVariant s;
   s.kind = "measured";
@@ -69,7 +71,7 @@ TEST_CASE("fill: the key and its constants are part of a measured sampling's ide
 
 TEST_CASE("fill: the training interpolant's pairs carry exactly the share of the weight") {
   const auto truth = declared_interpolant(true);
-  const FillChoice f = choose_fill(measured_sampling(-1.0), truth.get(), 77);
+  const FillChoice f = choose_fill(measured_sampling(-1.0), truth.get(), kOrbit, 77);
   REQUIRE(f.truth == truth.get());
   CHECK(f.share == kFillShare);
   CHECK(f.pairs == kFillPairs);
@@ -88,7 +90,7 @@ TEST_CASE("fill: the training interpolant's pairs carry exactly the share of the
   for (size_t k = 50; k < out.size(); k += 997)
     CHECK((out.value[k] - truth->eval(out.wi[k], out.wo[k])).abs().maxCoeff() == 0.0);
   // The fill never samples the whole-domain validation pairs of the same experiment seed.
-  const FillChoice g = choose_fill(measured_sampling(-1.0), truth.get(), fill_seed(3));
+  const FillChoice g = choose_fill(measured_sampling(-1.0), truth.get(), kOrbit, fill_seed(3));
   const SampleSet pairs = with_fill(SampleSet{}, g);
   const SampleSet val = validation_set(*truth, 1024, validation_seed(3));
   std::set<std::pair<double, double>> seen;
@@ -99,17 +101,22 @@ TEST_CASE("fill: the training interpolant's pairs carry exactly the share of the
   CHECK(fill_seed(3) != validation_seed(3));
 }
 
-TEST_CASE("fill: auto leaves undeclared samples alone and a share set there is refused naming the key") {
+TEST_CASE("fill: auto leaves undeclared samples and fits without symmetries alone and a share set there is refused") {
   const auto undeclared = declared_interpolant(false);
-  const FillChoice a = choose_fill(measured_sampling(-1.0), undeclared.get(), 1);
+  const FillChoice a = choose_fill(measured_sampling(-1.0), undeclared.get(), kOrbit, 1);
   CHECK(a.truth == nullptr);
   CHECK_THAT(a.why, Catch::Contains("declare"));
-  CHECK(choose_fill(measured_sampling(-1.0), nullptr, 1).truth == nullptr);
-  CHECK(choose_fill(measured_sampling(0.0), declared_interpolant(true).get(), 1).truth == nullptr);
-  CHECK_THROWS_WITH(choose_fill(measured_sampling(0.3), undeclared.get(), 1),
+  CHECK(choose_fill(measured_sampling(-1.0), nullptr, kOrbit, 1).truth == nullptr);
+  CHECK(choose_fill(measured_sampling(0.0), declared_interpolant(true).get(), kOrbit, 1).truth == nullptr);
+  // symmetries = "off": the fit sees the records alone, and auto adds nothing to them.
+  const FillChoice records = choose_fill(measured_sampling(-1.0), declared_interpolant(true).get(),
+                                         SymmetryChoice{Symmetries::all(), Symmetries{}, "off"}, 1);
+  CHECK(records.truth == nullptr);
+  CHECK_THAT(records.why, Catch::Contains("symmetries = \"off\""));
+  CHECK_THROWS_WITH(choose_fill(measured_sampling(0.3), undeclared.get(), kOrbit, 1),
                     Catch::Contains("cfg.toml:7") && Catch::Contains("sampling.fill") && Catch::Contains("declare"));
   // A set share on a BRDF that holds is used as given.
-  CHECK(choose_fill(measured_sampling(0.5), declared_interpolant(true).get(), 1).share == 0.5);
+  CHECK(choose_fill(measured_sampling(0.5), declared_interpolant(true).get(), kOrbit, 1).share == 0.5);
 }
 
 TEST_CASE("fill: on raw Cornell samples the fit follows the interpolant off the measured slice") {
