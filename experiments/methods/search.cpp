@@ -81,7 +81,10 @@ KeySpec with_default(KeySpec k, std::string default_text) {
 
 const std::vector<KeySpec>& search_keys() {
   static const std::vector<KeySpec> keys = [] {
-    std::vector<KeySpec> k = fit_keys(int_key("texture_size", 2, 1024, "16", "final resolution"));
+    std::vector<KeySpec> k = fit_keys(other_key("texture_size", "integer 2..1024 or `\"cv\"`", "16",
+                                                "final resolution; `\"cv\"` (raw samples): chosen by held-out error "
+                                                "from 8, 12, 16, 24, 32, the search run once at 16 and its "
+                                                "projections refit at each (docs/design.md §4.1 \"cv\")"));
     const auto r = refine_keys();
     k.insert(k.end(), r.begin(), r.end());
     const std::vector<KeySpec> own = {
@@ -332,7 +335,7 @@ class SearchKind final : public HomomorphicKind {
     if (m.tolerance) m.cap = m.terms;
     // texture_size = "cv": the search runs at the default 16 (SearchCvCache).
     m.texture_size = take_texture_cv(r, o) ? s.texture_size
-                                           : static_cast<int>(r.integer(key("texture_size"), s.texture_size));
+                                           : static_cast<int>(r.integer("texture_size", s.texture_size, 2, 1024));
     s.search_texture_size = static_cast<int>(r.integer("search_texture_size", 0, 0, 1024));
     if (s.search_texture_size == 1) r.fail("search_texture_size", "expected 0 (same as texture_size) or 2..1024, found 1");
     s.restarts = static_cast<int>(r.integer(key("restarts"), s.restarts));
