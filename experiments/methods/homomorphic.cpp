@@ -8,6 +8,7 @@
 #include "experiments/common/cli_util.h"
 #include "factor/export.h"
 #include "factor/refine.h"
+#include "factor/size_select.h"
 
 namespace bf {
 
@@ -16,8 +17,9 @@ using nlohmann::json;
 std::vector<KeySpec> fit_keys(const KeySpec& texture_size) {
   return {texture_size,
           num_key("smoothing", 0.0, FitOptions::kMaxWeight, false, "1e-3",
-                  "Laplacian weight relative to the mean sample weight per texel; `\"cv\"` (mccool, fit; raw "
-                  "samples): chosen by held-out error from 1e-4, 1e-3, 1e-2, 0.1, 1 (docs/design.md §4.1 \"cv\")"),
+                  "Laplacian weight relative to the mean sample weight per texel; `\"cv\"` (raw samples): chosen "
+                  "by held-out error from 1e-4, 1e-3, 1e-2, 0.1, 1 (the search: its projections, found once at "
+                  "1e-3, refit per candidate; docs/design.md §4.1 \"cv\")"),
           num_key("eps", 0.0, 1.0, true, "1e-5", "log-transform eps of the fit (docs/design.md §2)"),
           num_key("extrapolation_prior", 0.0, FitOptions::kMaxWeight, false, "0",
                   "weight (in mean sample weights) pulling the fit toward the data's mean log value where no "
@@ -33,8 +35,10 @@ std::vector<KeySpec> fit_keys(const KeySpec& texture_size) {
 }
 
 KeySpec homomorphic_texture_key() {
-  return other_key("texture_size", "integer 2..1024 or `\"auto\"`", "16",
-                   "textures are texture_size² texels; `\"auto\"`: chosen by the tolerance from `texture_ladder`");
+  return other_key("texture_size", "integer 2..1024, `\"auto\"` or `\"cv\"`", "16",
+                   "textures are texture_size² texels; `\"auto\"`: chosen by the tolerance from `texture_ladder`; "
+                   "`\"cv\"` (raw samples): chosen by held-out error from 8, 12, 16, 24, 32 (docs/design.md §4.1 "
+                   "\"cv\")");
 }
 
 std::vector<KeySpec> refine_keys() {
@@ -65,6 +69,17 @@ const KeySpec& refine_key(const std::string& name) {
 }
 
 }  // namespace
+
+bool take_texture_cv(Reader& r, json& o) {
+  const auto it = r.combo().find("texture_size");
+  if (it == r.combo().end() || it->second->value<std::string>() != std::optional<std::string>("cv")) return false;
+  r.take("texture_size");
+  o["texture_size"] = "cv";
+  if (r.take("texture_ladder"))
+    r.fail("texture_ladder", "texture_ladder applies only with texture_size = \"auto\"; texture_size = \"cv\" "
+                             "tries 8, 12, 16, 24, 32");
+  return true;
+}
 
 void read_fit_options(Reader& r, FitOptions& f, json& o) {
   f.eps = r.number(fit_key("eps"), f.eps);
@@ -118,18 +133,43 @@ void finish_refine_options(Reader& r, MethodVariant& m, json& o) {
   HomomorphicOptions& ho = homomorphic_options(m);
   RefineOptions& ro = ho.refine;
   const bool refine_follows = ro.smoothing < 0;  // the refinement uses the fit's smoothing
-  if (o.value("smoothing", json()) == json("cv")) {
-    if (m.kind != "mccool" && m.kind != "fit")
-      r.fail("smoothing", "\"cv\" is chosen for kinds mccool and fit (one refit per candidate and fold), found kind " +
-                              m.kind + ": give a number, or choose it with kind fit at the search's projections");
-    m.cv = MethodVariant::HeldOutChoice{
-        "smoothing", kCvSmoothingLadder, [refine_follows](MethodVariant& mv, double v) {
-          HomomorphicOptions& h = homomorphic_options(mv);
-          h.fit.smoothing = v;
-          h.search.fit.smoothing = v;
-          if (refine_follows) h.refine.smoothing = v;
-        }};
+  // Keys chosen by held-out error (docs/design.md §4.1 "cv"): the smoothing,
+  // the texture size, or both (their grid, size-major).
+  const bool cv_smoothing = o.value("smoothing", json()) == json("cv");
+  const bool cv_size = o.value("texture_size", json()) == json("cv");
+  const auto set_smoothing = [refine_follows](MethodVariant& mv, double v) {
+    HomomorphicOptions& h = homomorphic_options(mv);
+    h.fit.smoothing = v;
+    h.search.fit.smoothing = v;
+    if (refine_follows) h.refine.smoothing = v;
+    mv.options["smoothing"] = v;
+  };
+  const auto set_size = [](MethodVariant& mv, int n) {
+    HomomorphicOptions& h = homomorphic_options(mv);
+    mv.texture_size = n;
+    h.projections = terms_at_resolution(h.projections, n);
+    h.search.texture_size = n;
+    mv.options["texture_size"] = n;
+  };
+  if (cv_smoothing && cv_size) {
+    std::vector<double> grid;
+    for (size_t i = 0; i < kCvTextureLadder.size() * kCvSmoothingLadder.size(); ++i) grid.push_back(double(i));
+    m.cv = MethodVariant::HeldOutChoice{kCvGridKey, grid, [set_smoothing, set_size](MethodVariant& mv, double v) {
+                                          const size_t i = static_cast<size_t>(v), n = kCvSmoothingLadder.size();
+                                          set_size(mv, kCvTextureLadder[i / n]);
+                                          set_smoothing(mv, kCvSmoothingLadder[i % n]);
+                                        }};
+  } else if (cv_smoothing) {
+    m.cv = MethodVariant::HeldOutChoice{"smoothing", kCvSmoothingLadder, set_smoothing};
+  } else if (cv_size) {
+    m.cv = MethodVariant::HeldOutChoice{"texture_size",
+                                        std::vector<double>(kCvTextureLadder.begin(), kCvTextureLadder.end()),
+                                        [set_size](MethodVariant& mv, double v) { set_size(mv, int(v)); }};
   }
+  if (m.cv && m.kind == "search" && m.tolerance)
+    r.fail(cv_smoothing ? "smoothing" : "texture_size",
+           "\"cv\" refits the search's projections per candidate, but a tolerance stops the search at a term "
+           "count; give a number, or remove the tolerance");
   if (ro.smoothing < 0) ro.smoothing = ho.fit.smoothing;
   if (m.refine != "none") o["refine_smoothing"] = ro.smoothing;
   ro.threads = 1;

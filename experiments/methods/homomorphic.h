@@ -13,6 +13,11 @@
 
 namespace bf {
 
+// The search's state under a key chosen by held-out error (search.cpp): the
+// search at the base options, once per training set, shared by the variant's
+// copies (candidates, folds, the run's own fit).
+struct SearchCvCache;
+
 // The typed options of the homomorphic kinds (MethodVariant::typed).
 struct HomomorphicOptions {
   Parameterization param = Parameterization::WiWo;
@@ -21,6 +26,7 @@ struct HomomorphicOptions {
   std::vector<TermSpec> projections; // fit: all configured projections at texture_size
   SearchOptions search;              // search
   RefineOptions refine;              // the refinement stage (MethodVariant::refine names it)
+  std::shared_ptr<SearchCvCache> search_cv;  // search with a "cv" key: set by the search's reader
 };
 inline HomomorphicOptions& homomorphic_options(MethodVariant& m) { return kind_options<HomomorphicOptions>(m); }
 inline const HomomorphicOptions& homomorphic_options(const MethodVariant& m) {
@@ -31,6 +37,18 @@ inline const HomomorphicOptions& homomorphic_options(const MethodVariant& m) {
 // held-out error (k-fold, or the single held-out fraction), in this order;
 // the first of equal errors wins. Decades around the default 1e-3.
 inline const std::vector<double> kCvSmoothingLadder = {1e-4, 1e-3, 1e-2, 1e-1, 1.0};
+// `texture_size = "cv"` (mccool, fit, search; raw samples): the resolutions
+// tried the same way, the default 16 in the middle.
+inline const std::vector<int> kCvTextureLadder = {8, 12, 16, 24, 32};
+
+// The key chosen by held-out error when both are "cv": the grid
+// kCvTextureLadder x kCvSmoothingLadder, size-major (MethodVariant::cv.key).
+inline const char* const kCvGridKey = "texture_size and smoothing";
+
+// texture_size = "cv": takes the key when its value is the string "cv" and
+// records o["texture_size"] = "cv" (finish_refine_options then sets
+// MethodVariant::cv); false, untouched, otherwise.
+bool take_texture_cv(Reader& r, nlohmann::json& o);
 
 // The fit keys (texture_size with the given default docs, smoothing, eps,
 // subtract_eps, solve_last, solver) and the refinement keys.

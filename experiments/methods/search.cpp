@@ -4,8 +4,11 @@
 // whose refit reaches the target. Keys the search gains go here.
 #include <algorithm>
 #include <cmath>
+#include <map>
+#include <mutex>
 
 #include "experiments/methods/homomorphic.h"
+#include "factor/size_select.h"
 #include "search/rotation4.h"
 #include "search/term_search.h"
 #include "solvers/parallel.h"
@@ -14,7 +17,62 @@ namespace bf {
 
 using nlohmann::json;
 
+// A search with a key chosen by held-out error (docs/design.md §4.1 "cv"):
+// the search runs once per fit set at `base` (the configured options; a "cv"
+// key at its default: smoothing 1e-3, texture_size 16), and every candidate
+// refits the projections it found. Keyed by the fit set's content, so the
+// candidates of one fold (or of the held-out fraction) share one search, and
+// the run's own fit on the same training samples reuses it.
+struct SearchCvCache {
+  SearchOptions base;
+  std::mutex mu;
+  std::map<uint64_t, std::shared_ptr<const SearchResult>> searched;
+};
+
 namespace {
+
+// 64-bit FNV-1a of a sample set's directions, values, weights and mask.
+uint64_t fingerprint(const SampleSet& s) {
+  uint64_t h = 1469598103934665603ULL;
+  const auto feed = [&h](const void* p, size_t n) {
+    const auto* b = static_cast<const unsigned char*>(p);
+    for (size_t i = 0; i < n; ++i) h = (h ^ b[i]) * 1099511628211ULL;
+  };
+  const size_t n = s.size();
+  feed(&n, sizeof n);
+  feed(s.wi.data(), s.wi.size() * sizeof(Vec3));
+  feed(s.wo.data(), s.wo.size() * sizeof(Vec3));
+  feed(s.value.data(), s.value.size() * sizeof(Rgb));
+  feed(s.weight.data(), s.weight.size() * sizeof(double));
+  feed(s.valid.data(), s.valid.size());
+  return h;
+}
+
+// r's answers (greedy: its factorization, the schedule) refit on `data` at
+// resolution res with fo, as the search refits them (the structured search
+// solves all terms jointly with final_joint).
+void refit_at(const FitData& data, const FitOptions& fo, bool final_joint, int res, SearchResult& r) {
+  const bool joint = r.strategy == "structured" && final_joint;
+  const auto refit = [&](const HomomorphicFactorization& f, std::vector<double>* errors) {
+    std::vector<TermSpec> sp;
+    for (const FactorTerm& t : f.terms()) sp.push_back(TermSpec{t.proj, t.reciprocal, t.rotation});
+    FitOptions o = fo;
+    if (joint) o.solve_last = std::max(o.solve_last, static_cast<int>(sp.size()));
+    return fit_homomorphic(data, terms_at_resolution(sp, res), o, "search", errors);
+  };
+  std::vector<double> errors;
+  if (r.answers.empty()) {
+    r.factorization = refit(*r.factorization, &errors);
+    r.rel_mse_after_term = errors;
+    return;
+  }
+  for (size_t k = 0; k < r.answers.size(); ++k) {
+    if (!r.answers[k]) continue;
+    r.answers[k] = refit(*r.answers[k], &errors);
+    r.rel_mse_after_term[k] = errors.back();
+  }
+  r.factorization = r.answers.back();
+}
 
 KeySpec with_default(KeySpec k, std::string default_text) {
   k.default_text = std::move(default_text);
@@ -23,7 +81,10 @@ KeySpec with_default(KeySpec k, std::string default_text) {
 
 const std::vector<KeySpec>& search_keys() {
   static const std::vector<KeySpec> keys = [] {
-    std::vector<KeySpec> k = fit_keys(int_key("texture_size", 2, 1024, "16", "final resolution"));
+    std::vector<KeySpec> k = fit_keys(other_key("texture_size", "integer 2..1024 or `\"cv\"`", "16",
+                                                "final resolution; `\"cv\"` (raw samples): chosen by held-out error "
+                                                "from 8, 12, 16, 24, 32, the search run once at 16 and its "
+                                                "projections refit at each (docs/design.md §4.1 \"cv\")"));
     const auto r = refine_keys();
     k.insert(k.end(), r.begin(), r.end());
     const std::vector<KeySpec> own = {
@@ -153,7 +214,7 @@ void record_options(const MethodVariant& m, json& o) {
   const SearchOptions& s = h.search;
   o["parameterization"] = to_string(h.param);
   o["terms"] = m.terms;
-  o["texture_size"] = m.texture_size;
+  if (o.value("texture_size", json()) != json("cv")) o["texture_size"] = m.texture_size;
   o["search_texture_size"] = s.search_texture_size;
   o["restarts"] = s.restarts;
   o["guesses"] = s.guesses;
@@ -272,7 +333,9 @@ class SearchKind final : public HomomorphicKind {
     // at the first term whose refit reaches the target.
     m.terms = static_cast<int>(r.integer(key("terms"), m.tolerance ? 8 : s.terms));
     if (m.tolerance) m.cap = m.terms;
-    m.texture_size = static_cast<int>(r.integer(key("texture_size"), s.texture_size));
+    // texture_size = "cv": the search runs at the default 16 (SearchCvCache).
+    m.texture_size = take_texture_cv(r, o) ? s.texture_size
+                                           : static_cast<int>(r.integer("texture_size", s.texture_size, 2, 1024));
     s.search_texture_size = static_cast<int>(r.integer("search_texture_size", 0, 0, 1024));
     if (s.search_texture_size == 1) r.fail("search_texture_size", "expected 0 (same as texture_size) or 2..1024, found 1");
     s.restarts = static_cast<int>(r.integer(key("restarts"), s.restarts));
@@ -315,12 +378,17 @@ class SearchKind final : public HomomorphicKind {
       }
     }
     finish_refine_options(r, m, o);
+    if (m.cv) {
+      h.search_cv = std::make_shared<SearchCvCache>();
+      h.search_cv->base = s;
+    }
   }
 
   MethodOutcome run(const RunContext& c) const override {
     const MethodVariant& m = c.method;
     const HomomorphicOptions& h = homomorphic_options(m);
     const FitData data(c.samples, h.fit.eps);
+    if (h.search_cv) return run_cv(c, data);
     SearchOptions so = h.search;
     SizeChoice choice;  // with a tolerance: the terms tried, filled as the search goes
     if (m.tolerance) {
@@ -346,6 +414,44 @@ class SearchKind final : public HomomorphicKind {
       choice.errors_after_term = sr.rel_mse_after_term;
       chosen = choice;
     }
+    return outcome_of(c, std::move(sr), std::move(chosen));
+  }
+
+ private:
+  // A run under a "cv" key: the search at the base options (once per fit
+  // set, SearchCvCache), its projections refit at this candidate's smoothing
+  // and texture size. run.json `search_cv` says which, and whether this call
+  // ran the search or reused it.
+  MethodOutcome run_cv(const RunContext& c, const FitData& data) const {
+    const MethodVariant& m = c.method;
+    const HomomorphicOptions& h = homomorphic_options(m);
+    SearchCvCache& cache = *h.search_cv;
+    const uint64_t key = fingerprint(c.samples);
+    std::shared_ptr<const SearchResult> base;
+    {
+      std::lock_guard<std::mutex> lk(cache.mu);
+      if (const auto it = cache.searched.find(key); it != cache.searched.end()) base = it->second;
+    }
+    const bool reused = base != nullptr;
+    if (!base) {
+      base = std::make_shared<const SearchResult>(search_factorization(data, cache.base));
+      std::lock_guard<std::mutex> lk(cache.mu);
+      cache.searched.emplace(key, base);
+    }
+    SearchResult sr = *base;
+    refit_at(data, h.fit, cache.base.final_joint, m.texture_size, sr);
+    MethodOutcome out = outcome_of(c, std::move(sr), std::nullopt);
+    out.record["search_cv"] = {{"base_smoothing", cache.base.fit.smoothing},
+                               {"base_texture_size", cache.base.texture_size},
+                               {"search", reused ? "reused" : "ran"},
+                               {"search_seconds", base->seconds},
+                               {"smoothing", h.fit.smoothing},
+                               {"texture_size", m.texture_size}};
+    return out;
+  }
+
+  // The outcome of a search result: the refinement, the row's state and run.json's search entries.
+  MethodOutcome outcome_of(const RunContext& c, SearchResult sr, std::optional<SizeChoice> chosen) const {
     HomomorphicRun run;
     run.h = sr.factorization;
     run.errors_after_term = sr.rel_mse_after_term;
@@ -354,7 +460,7 @@ class SearchKind final : public HomomorphicKind {
     out.record["search_strategy"] = sr.strategy;
     // What the search's candidates were evaluated on (the final fit and the
     // metrics use every sample): a stratified subsample above search_samples.
-    out.record["search_subsample"] = {{"threshold", so.search_samples},
+    out.record["search_subsample"] = {{"threshold", homomorphic_options(c.method).search.search_samples},
                                       {"samples", sr.search_samples},
                                       {"of", sr.data_samples},
                                       {"subsampled", sr.search_samples < sr.data_samples},

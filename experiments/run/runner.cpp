@@ -285,20 +285,42 @@ HeldOutStage held_out_stage(const Plan& plan, const PlannedRun& pr, const Method
     size_t best = 0;
     double best_err = std::numeric_limits<double>::infinity();
     std::vector<std::vector<Metrics>> per_candidate;
+    // Several keys chosen together ("texture_size and smoothing"): the ladder
+    // numbers the grid; each candidate's values are read from the options
+    // its apply set.
+    std::vector<std::string> parts;
+    for (size_t at = 0, and_at; at <= m.cv->key.size(); at = and_at + 5) {
+      and_at = m.cv->key.find(" and ", at);
+      if (and_at == std::string::npos) and_at = m.cv->key.size();
+      parts.push_back(m.cv->key.substr(at, and_at - at));
+    }
+    const auto values_of = [&](const MethodVariant& mv, std::string* label) {
+      json v = json::object();
+      std::vector<std::string> shown;
+      for (const std::string& p : parts) {
+        v[p] = mv.options.value(p, json());
+        shown.push_back(format_short(v[p].is_number() ? format_number(v[p].get<double>()) : v[p].dump()));
+      }
+      *label = join(shown, "/");
+      return v;
+    };
     for (size_t i = 0; i < m.cv->ladder.size(); ++i) {
       MethodVariant mv = m;
       m.cv->apply(mv, m.cv->ladder[i]);
+      std::string label = format_short(format_number(m.cv->ladder[i]));
+      json values = parts.size() > 1 ? values_of(mv, &label) : json();
       std::vector<Metrics> sc;
       if (use_folds)
         for (const HoldoutSplit& h : *folds) sc.push_back(held_out_score(h, mv));
       else
         sc.push_back(held_out_score(*split, mv));
       const FoldSummary fs = summarize_folds(sc);
-      cands.push_back({{"value", m.cv->ladder[i]},
-                       {"holdout_rel_mse", fs.rel_mse_mean},
-                       {"holdout_cos_rmse", fs.cos_rmse_mean}});
-      words.push_back(format_short(format_number(m.cv->ladder[i])) + ": " +
-                      format_short(format_number(fs.rel_mse_mean)));
+      json cand = {{"value", m.cv->ladder[i]},
+                   {"holdout_rel_mse", fs.rel_mse_mean},
+                   {"holdout_cos_rmse", fs.cos_rmse_mean}};
+      if (values.is_object()) cand.update(values);
+      cands.push_back(cand);
+      words.push_back(label + ": " + format_short(format_number(fs.rel_mse_mean)));
       if (std::isfinite(fs.rel_mse_mean) && fs.rel_mse_mean < best_err) best_err = fs.rel_mse_mean, best = i;
       per_candidate.push_back(std::move(sc));
     }
@@ -309,8 +331,9 @@ HeldOutStage held_out_stage(const Plan& plan, const PlannedRun& pr, const Method
     if (use_folds) chosen_folds = per_candidate[best];
     rec["cv"] = {{"key", m.cv->key}, {"by", by}, {"candidates", cands}, {"chosen", chosen},
                  {"seconds", since(tc)}};
-    cv_note = m.cv->key + " = \"cv\" chose " + format_short(format_number(chosen)) + " by " + by + " (" +
-              join(words, ", ") + ")";
+    std::string chosen_label = format_short(format_number(chosen));
+    if (parts.size() > 1) rec["cv"]["chosen_values"] = values_of(m, &chosen_label);
+    cv_note = m.cv->key + " = \"cv\" chose " + chosen_label + " by " + by + " (" + join(words, ", ") + ")";
   }
   if (use_folds) {
     const auto tf = Clock::now();
