@@ -592,14 +592,41 @@ void Structured::reseed(std::vector<Term>& ts, double& value, TermRecord* rec) {
     // frame does not predict which one reaches the true pair (measured), so
     // every start gets a Powell run.
     if (round == 0) {
+      constexpr size_t kNone = std::numeric_limits<size_t>::max();
       struct PairStart {
         size_t i, k;
         Parameterization p;
         Rotation4 R;
+        const std::vector<Term>* base;
       };
+      // Powell from each start; the results join `found`.
+      const auto run_pairs = [&](const std::vector<PairStart>& starts) {
+        std::vector<Found> pf(starts.size());
+        parallel_for(starts.size(), opt_.threads, [&](size_t q) {
+          const PairStart& st = starts[q];
+          const auto with = [&](const Rotation4& R) {
+            std::vector<Term> t = *st.base;
+            t[st.i] = Term{R, st.p};
+            t[st.k] = Term{swapped(R), st.p};
+            return t;
+          };
+          const auto objective = [&](const Rotation4& R) { return schedule(with(R.normalized()), nullptr, n); };
+          const PowellResult r = powell_minimize(objective, st.R, opt_.powell);
+          pf[q].ts = with(r.best.normalized());
+          pf[q].value = r.value;
+          pf[q].fits = r.evaluations;
+        });
+        size_t best = kNone;
+        for (const Found& f : pf) {
+          found.push_back(f);
+          if (std::isfinite(f.value) && (best == kNone || f.value < found[best].value)) best = found.size() - 1;
+        }
+        return best;  // the lowest result's index in found (kNone if none)
+      };
+      std::vector<size_t> picks(2, subsets.size());
       std::vector<PairStart> starts;
       for (Parameterization p : params_) {
-        size_t pick = subsets.size();
+        size_t& pick = picks[pidx(p)];
         for (size_t si = 0; si < subsets.size(); ++si)
           if (subsets[si].size() == 2 && pair_read[si][pidx(p)] < kPairRestartWithin * value &&
               (pick == subsets.size() || pair_read[si][pidx(p)] < pair_read[pick][pidx(p)]))
@@ -607,24 +634,30 @@ void Structured::reseed(std::vector<Term>& ts, double& value, TermRecord* rec) {
         if (pick == subsets.size()) continue;
         std::mt19937_64 rng(opt_.seed * 1000003ull + 0x9a17ull + pidx(p));
         for (int r = 0; r < kPairRestarts; ++r)
-          starts.push_back({subsets[pick][0], subsets[pick][1], p, Rotation4::random(rng)});
+          starts.push_back({subsets[pick][0], subsets[pick][1], p, Rotation4::random(rng), &ts});
       }
-      std::vector<Found> pf(starts.size());
-      parallel_for(starts.size(), opt_.threads, [&](size_t q) {
-        const PairStart& st = starts[q];
-        const auto with = [&](const Rotation4& R) {
-          std::vector<Term> t = ts;
-          t[st.i] = Term{R, st.p};
-          t[st.k] = Term{swapped(R), st.p};
-          return t;
-        };
-        const auto objective = [&](const Rotation4& R) { return schedule(with(R.normalized()), nullptr, n); };
-        const PowellResult r = powell_minimize(objective, st.R, opt_.powell);
-        pf[q].ts = with(r.best.normalized());
-        pf[q].value = r.value;
-        pf[q].fits = r.evaluations;
-      });
-      found.insert(found.end(), pf.begin(), pf.end());
+      const size_t first = found.size();
+      const size_t best = run_pairs(starts);
+      // Four terms, two disjoint pairs (one per parameterization): when one
+      // pair is wrong the other pair's restarts cannot reach its true planes
+      // (their error is masked), so the other pair is restarted again on top
+      // of the first stage's lowest result.
+      if (J == 4 && best != kNone && picks[0] < subsets.size() && picks[1] < subsets.size()) {
+        const std::vector<size_t>&A = subsets[picks[0]], &B = subsets[picks[1]];
+        const bool disjoint = std::find(B.begin(), B.end(), A[0]) == B.end() &&
+                              std::find(B.begin(), B.end(), A[1]) == B.end();
+        if (disjoint) {
+          // The stage-1 starts are in order (p0's, then p1's): which pair moved.
+          const bool moved_p0 = best - first < static_cast<size_t>(kPairRestarts);
+          const Parameterization q = moved_p0 ? params_[1] : params_[0];
+          const std::vector<size_t>& other = moved_p0 ? B : A;
+          const std::vector<Term> base = found[best].ts;
+          std::mt19937_64 rng(opt_.seed * 1000003ull + 0x9a19ull + pidx(q));
+          std::vector<PairStart> again;
+          for (int r = 0; r < kPairRestarts; ++r) again.push_back({other[0], other[1], q, Rotation4::random(rng), &base});
+          run_pairs(again);
+        }
+      }
       order.resize(found.size());
       for (size_t i = 0; i < order.size(); ++i) order[i] = i;
       std::stable_sort(order.begin(), order.end(),
