@@ -25,6 +25,10 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 // subsets grow as J^2 and each round polishes up to J + 1 configurations, so
 // larger searches (W1's 5 terms) skip it.
 constexpr int kReseedTerms = 4;
+// Re-seeding's pair restarts: random frames per parameterization, and how far
+// above the current objective a pair's replacement may start to get them.
+constexpr int kPairRestarts = 8;
+constexpr double kPairRestartWithin = 3;
 
 struct Term {
   Rotation4 R;
@@ -43,6 +47,14 @@ int pidx(Parameterization p) { return p == Parameterization::WiWo ? 0 : 1; }
 double plane_distance(const Rotation4& a, const Rotation4& b) {
   const Eigen::Matrix4d A = a.matrix(), B = b.matrix();
   return 2 - (A.leftCols<2>().transpose() * B.leftCols<2>()).squaredNorm();
+}
+
+// The same frame with its two planes exchanged (columns (0 2)(1 3): det +1).
+Rotation4 swapped(const Rotation4& R) {
+  const Eigen::Matrix4d Q = R.matrix();
+  Eigen::Matrix4d S;
+  S << Q.col(2), Q.col(3), Q.col(0), Q.col(1);
+  return Rotation4::from_matrix(S);
 }
 
 size_t first_joint(size_t step, int n) {
@@ -185,7 +197,10 @@ double Structured::schedule(const std::vector<Term>& ts, std::vector<FactorTerm>
   const std::vector<TermSpec> sp = specs(ts, sres_);
   std::vector<FactorTerm> done;
   double value = kInf;
-  for (size_t s = 0; s < sp.size(); ++s) {
+  // With every term solved jointly the last step re-solves all of them, so
+  // the earlier steps (whose texels it replaces) are skipped.
+  const size_t s0 = static_cast<size_t>(n) >= sp.size() && !sp.empty() ? sp.size() - 1 : 0;
+  for (size_t s = s0; s < sp.size(); ++s) {
     const size_t first = first_joint(s, n);
     std::vector<FactorTerm> fixed(done.begin(), done.begin() + first);
     std::vector<TermSpec> joint(sp.begin() + first, sp.begin() + s + 1);
@@ -514,6 +529,8 @@ void Structured::reseed(std::vector<Term>& ts, double& value, TermRecord* rec) {
       int fits = 0;
     };
     std::vector<Found> found(subsets.size());
+    // The joint objective of each pair's first replacement, per parameterization.
+    std::vector<std::array<double, 2>> pair_read(subsets.size(), {kInf, kInf});
     parallel_for(subsets.size(), opt_.threads, [&](size_t si) {
       const std::vector<size_t>& S = subsets[si];
       Found& f = found[si];
@@ -543,6 +560,7 @@ void Structured::reseed(std::vector<Term>& ts, double& value, TermRecord* rec) {
             std::vector<FactorTerm> td;
             const double v = schedule(t, &td, n);
             ++f.fits;
+            if (it == 0 && S.size() == 2) pair_read[si][pidx(p)] = v;
             if (v < best) {
               best = v;
               best_ts = std::move(t);
@@ -562,6 +580,89 @@ void Structured::reseed(std::vector<Term>& ts, double& value, TermRecord* rec) {
     std::vector<size_t> order(found.size());
     for (size_t i = 0; i < order.size(); ++i) order[i] = i;
     std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return found[a].value < found[b].value; });
+    // Pair restarts (first round): two terms of one parameterization may sit
+    // in a mixed local minimum (each plane part of both true planes) that no
+    // move of one term, and no Powell over their common frame from the
+    // current pair or from the residual's split, leaves (planted mixed member
+    // 1, halfdiff). In each parameterization p, the pair whose replacement by
+    // the residual's split in p is lowest (within kPairRestartWithin of now)
+    // is searched as one frame (plane A and its orthogonal complement) under
+    // the joint objective from kPairRestarts random frames; the results
+    // compete with the replacements below. The screened value of a random
+    // frame does not predict which one reaches the true pair (measured), so
+    // every start gets a Powell run.
+    if (round == 0) {
+      constexpr size_t kNone = std::numeric_limits<size_t>::max();
+      struct PairStart {
+        size_t i, k;
+        Parameterization p;
+        Rotation4 R;
+        const std::vector<Term>* base;
+      };
+      // Powell from each start; the results join `found`.
+      const auto run_pairs = [&](const std::vector<PairStart>& starts) {
+        std::vector<Found> pf(starts.size());
+        parallel_for(starts.size(), opt_.threads, [&](size_t q) {
+          const PairStart& st = starts[q];
+          const auto with = [&](const Rotation4& R) {
+            std::vector<Term> t = *st.base;
+            t[st.i] = Term{R, st.p};
+            t[st.k] = Term{swapped(R), st.p};
+            return t;
+          };
+          const auto objective = [&](const Rotation4& R) { return schedule(with(R.normalized()), nullptr, n); };
+          const PowellResult r = powell_minimize(objective, st.R, opt_.powell);
+          pf[q].ts = with(r.best.normalized());
+          pf[q].value = r.value;
+          pf[q].fits = r.evaluations;
+        });
+        size_t best = kNone;
+        for (const Found& f : pf) {
+          found.push_back(f);
+          if (std::isfinite(f.value) && (best == kNone || f.value < found[best].value)) best = found.size() - 1;
+        }
+        return best;  // the lowest result's index in found (kNone if none)
+      };
+      std::vector<size_t> picks(2, subsets.size());
+      std::vector<PairStart> starts;
+      for (Parameterization p : params_) {
+        size_t& pick = picks[pidx(p)];
+        for (size_t si = 0; si < subsets.size(); ++si)
+          if (subsets[si].size() == 2 && pair_read[si][pidx(p)] < kPairRestartWithin * value &&
+              (pick == subsets.size() || pair_read[si][pidx(p)] < pair_read[pick][pidx(p)]))
+            pick = si;
+        if (pick == subsets.size()) continue;
+        std::mt19937_64 rng(opt_.seed * 1000003ull + 0x9a17ull + pidx(p));
+        for (int r = 0; r < kPairRestarts; ++r)
+          starts.push_back({subsets[pick][0], subsets[pick][1], p, Rotation4::random(rng), &ts});
+      }
+      const size_t first = found.size();
+      const size_t best = run_pairs(starts);
+      // Four terms, two disjoint pairs (one per parameterization): when one
+      // pair is wrong the other pair's restarts cannot reach its true planes
+      // (their error is masked), so the other pair is restarted again on top
+      // of the first stage's lowest result.
+      if (J == 4 && best != kNone && picks[0] < subsets.size() && picks[1] < subsets.size()) {
+        const std::vector<size_t>&A = subsets[picks[0]], &B = subsets[picks[1]];
+        const bool disjoint = std::find(B.begin(), B.end(), A[0]) == B.end() &&
+                              std::find(B.begin(), B.end(), A[1]) == B.end();
+        if (disjoint) {
+          // The stage-1 starts are in order (p0's, then p1's): which pair moved.
+          const bool moved_p0 = best - first < static_cast<size_t>(kPairRestarts);
+          const Parameterization q = moved_p0 ? params_[1] : params_[0];
+          const std::vector<size_t>& other = moved_p0 ? B : A;
+          const std::vector<Term> base = found[best].ts;
+          std::mt19937_64 rng(opt_.seed * 1000003ull + 0x9a19ull + pidx(q));
+          std::vector<PairStart> again;
+          for (int r = 0; r < kPairRestarts; ++r) again.push_back({other[0], other[1], q, Rotation4::random(rng), &base});
+          run_pairs(again);
+        }
+      }
+      order.resize(found.size());
+      for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+      std::stable_sort(order.begin(), order.end(),
+                       [&](size_t a, size_t b) { return found[a].value < found[b].value; });
+    }
     for (const Found& f : found) {
       evaluations_ += f.fits;
       rec->backfit_evaluations += f.fits;

@@ -293,13 +293,12 @@ TEST_CASE("structured search: mixed planted family ends near the joint floor", "
   // the other; 16^4 grid, texture 16. The floor is the fit at all true planes
   // solved jointly; bounds 2x (3 terms) and 3x (4 terms). Before the joint
   // re-seeding (Structured::reseed) these members ended 5.5x-30x above it,
-  // but for member 0 (3 terms, wiwo). Member 1 in halfdiff still ends at
-  // 11.9x (3 terms: its halfdiff pair stays mixed) and 11.8x (4 terms: every
-  // term wiwo); docs/search.md "Not done". Left out until the search finds them.
+  // but for member 0 (3 terms, wiwo); before its pair moves, member 1 in
+  // halfdiff ended at 11.9x (3 terms: its halfdiff pair stayed mixed) and
+  // 11.8x (4 terms: every term wiwo).
   for (int i : {0, 1})
     for (int terms : {3, 4})
       for (Parameterization p : {Parameterization::WiWo, Parameterization::HalfDiff}) {
-        if (i == 1 && p == Parameterization::HalfDiff) continue;
         const PlantedProductBrdf b = planted_rotation_brdf(i, terms, p);
         const SampleSet s = sample_grid(b, 16);
         const FitData d(s, 1e-5);
