@@ -123,8 +123,8 @@ struct SamplingVariant {
   // (each table cell weighted by the hemisphere-pair measure it stands for) | "none".
   std::string weights = "auto";
   // measured: the whole-domain fill (experiments/run/symmetry_prep.h, docs/design.md
-  // §4.5): -1 = "auto" (kFillShare when the samples' interpolant holds over the
-  // whole domain and they are scattered), 0 = "off", else the fill's share of the fit's weight.
+  // §4.5): -1 = "auto" (kFillShare when the training BRDF holds over the whole domain
+  // and the fit uses its symmetries), 0 = "off", else the fill's share of the fit's weight.
   double fill = -1.0;
   std::string label;        // "grid 16^4", "stratified 20000 seed 1", "file x.csv", "measured"
   std::string where;

@@ -3,10 +3,6 @@
 #include <cmath>
 #include <stdexcept>
 
-#if __has_include("brdfs/measured.h")
-#include "brdfs/measured.h"
-#define BF_HAVE_MEASURED 1
-#endif
 
 namespace bf {
 
@@ -61,17 +57,11 @@ FillChoice choose_fill(const SamplingVariant& s, const Brdf* training, const Sym
   }
   std::string why = "no measured BRDF made of the training samples";
   const bool whole = training && training->whole_domain(&why);
-#ifdef BF_HAVE_MEASURED
-  const bool scattered = training && dynamic_cast<const MeasuredBrdf*>(training) != nullptr;
-#else
-  const bool scattered = false;
-#endif
   if (s.fill < 0.0) {
-    if (!whole || !scattered || !sym.used.any()) {
-      f.why = !whole       ? why
-              : !scattered ? "a table whose cells cover the domain (fill = \"auto\" fills scattered samples only)"
-                           : "the fit uses no symmetries (symmetries = \"" + sym.key +
-                                 "\"): fill = \"auto\" fills only fits of the samples' orbit";
+    if (!whole || !sym.used.any()) {
+      f.why = !whole ? why
+                     : "the fit uses no symmetries (symmetries = \"" + sym.key +
+                           "\"): fill = \"auto\" fills only fits of the samples' orbit";
       return f;
     }
     f.share = kFillShare;

@@ -55,8 +55,8 @@ struct FillChoice {
 // The sampling's `fill` (plan.h: -1 auto, 0 off, else a share) for a run
 // whose training BRDF is `training` (the measured BRDF made of the training
 // samples, or nullptr) and whose fit uses the symmetries `sym`. "auto" fills
-// (kFillShare) only scattered samples (brdfs/measured.h MeasuredBrdf) whose
-// interpolant holds over the whole domain, and only when the fit uses their
+// (kFillShare) when that BRDF holds over the whole domain (the interpolant of
+// samples declaring all three symmetries, a MERL table) and the fit uses the
 // symmetries (with symmetries = "off" the fit sees the records alone, as the
 // thesis's); a share the user set needs a training BRDF that holds over the
 // whole domain, else std::invalid_argument naming sampling.fill.

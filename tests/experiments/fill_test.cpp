@@ -5,6 +5,8 @@
 
 #include "brdfs/catalogue.h"
 #include "brdfs/measured.h"
+#include "brdfs/merl.h"
+#include "brdfs/models.h"
 #include "experiments/report/outputs.h"
 #include "experiments/report/validation.h"
 #include "experiments/run/symmetry_prep.h"
@@ -115,6 +117,11 @@ TEST_CASE("fill: auto leaves undeclared samples and fits without symmetries alon
   CHECK_THAT(records.why, Catch::Contains("symmetries = \"off\""));
   CHECK_THROWS_WITH(choose_fill(measured_sampling(0.3), undeclared.get(), kOrbit, 1),
                     Catch::Contains("cfg.toml:7") && Catch::Contains("sampling.fill") && Catch::Contains("declare"));
+  // A MERL table holds over the whole domain: auto fills it too (its cells sit on one
+  // slice of (theta_h, theta_d, phi_d) at their centres; the fill reads its lookup between them).
+  const MerlBrdf merl(std::make_shared<const MerlTable>(merl_tabulate(Lambert(LambertParams{}))),
+                      MerlLookup::Linear, "lambert.binary");
+  CHECK(choose_fill(measured_sampling(-1.0), &merl, kOrbit, 1).share == kFillShare);
   // A set share on a BRDF that holds is used as given.
   CHECK(choose_fill(measured_sampling(0.5), declared_interpolant(true).get(), kOrbit, 1).share == 0.5);
 }
