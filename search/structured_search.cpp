@@ -165,6 +165,27 @@ class Structured {
   // and kept if the joint objective falls; rounds until nothing moves.
   // value: the joint objective of ts on return.
   void reseed(std::vector<Term>& ts, double& value, TermRecord* rec);
+  // One candidate of reseed: its terms, joint objective and fits spent.
+  struct Reseeded {
+    std::vector<Term> ts;
+    double value = kInf;
+    int fits = 0;
+  };
+  // reseed's replacements of each subset (a term or a pair) of ts, whose joint
+  // fit is `done` at `value`; pair_read[si][p]: the joint objective of pair
+  // si's first replacement in parameterization p.
+  std::vector<Reseeded> reseed_replacements(const std::vector<Term>& ts, const std::vector<FactorTerm>& done,
+                                            double value, const std::vector<std::vector<size_t>>& subsets, int n,
+                                            std::vector<std::array<double, 2>>& pair_read);
+  // reseed's pair restarts (first round; see there), appended to found.
+  void reseed_pair_restarts(const std::vector<Term>& ts, double value,
+                            const std::vector<std::vector<size_t>>& subsets,
+                            const std::vector<std::array<double, 2>>& pair_read, int n,
+                            std::vector<Reseeded>& found);
+  // reseed's choice among found (sorted by `order`): the candidates polished
+  // and the one kept; true (ts, value updated) when the joint objective fell.
+  bool reseed_keep(std::vector<Term>& ts, double& value, std::vector<Reseeded>& found,
+                   const std::vector<size_t>& order, int n, const PowellOptions& fine, TermRecord* rec);
   // A k-term answer: its terms, their refit at texture_size and its error.
   struct Answer {
     std::vector<Term> ts;
@@ -505,6 +526,185 @@ void Structured::polish(std::vector<Term>& ts, double& value, size_t from, int s
   rec->seconds += now_seconds() - t0;
 }
 
+std::vector<Structured::Reseeded> Structured::reseed_replacements(
+    const std::vector<Term>& ts, const std::vector<FactorTerm>& done, double value,
+    const std::vector<std::vector<size_t>>& subsets, int n, std::vector<std::array<double, 2>>& pair_read) {
+  const size_t J = ts.size();
+  std::vector<Reseeded> found(subsets.size());
+  pair_read.assign(subsets.size(), {kInf, kInf});
+  parallel_for(subsets.size(), opt_.threads, [&](size_t si) {
+    const std::vector<size_t>& S = subsets[si];
+    Reseeded& f = found[si];
+    std::vector<Term> cur = ts;
+    std::vector<FactorTerm> cdone = done;
+    double cv = value;
+    for (int it = 0; it < 3; ++it) {
+      std::vector<FactorTerm> others;
+      for (size_t i = 0; i < J; ++i)
+        if (std::find(S.begin(), S.end(), i) == S.end()) others.push_back(cdone[i]);
+      std::vector<Term> best_ts;
+      std::vector<FactorTerm> best_done;
+      double best = kInf;
+      for (const auto& [p, sp] : seeds(residual(others))) {
+        std::vector<std::vector<Term>> trials;
+        if (S.size() == 2) {
+          trials.push_back(cur);
+          trials.back()[S[0]] = Term{sp.first, p};
+          trials.back()[S[1]] = Term{sp.second, p};
+        } else {
+          trials.push_back(cur);
+          trials.back()[S[0]] = Term{sp.first, p};
+          trials.push_back(cur);
+          trials.back()[S[0]] = Term{sp.second, p};
+        }
+        for (std::vector<Term>& t : trials) {
+          std::vector<FactorTerm> td;
+          const double v = schedule(t, &td, n);
+          ++f.fits;
+          if (it == 0 && S.size() == 2) pair_read[si][pidx(p)] = v;
+          if (v < best) {
+            best = v;
+            best_ts = std::move(t);
+            best_done = std::move(td);
+          }
+        }
+      }
+      if (it > 0 && !(best < cv * (1 - 1e-6))) break;
+      cur = std::move(best_ts);
+      cdone = std::move(best_done);
+      cv = best;
+      if (!std::isfinite(cv)) break;
+    }
+    f.ts = cur;
+    f.value = cv;
+  });
+  return found;
+}
+
+// Pair restarts (first round): two terms of one parameterization may sit
+// in a mixed local minimum (each plane part of both true planes) that no
+// move of one term, and no Powell over their common frame from the
+// current pair or from the residual's split, leaves (planted mixed member
+// 1, halfdiff). In each parameterization p, the pair whose replacement by
+// the residual's split in p is lowest (within kPairRestartWithin of now)
+// is searched as one frame (plane A and its orthogonal complement) under
+// the joint objective from kPairRestarts random frames; the results
+// compete with the replacements below. The screened value of a random
+// frame does not predict which one reaches the true pair (measured), so
+// every start gets a Powell run.
+void Structured::reseed_pair_restarts(const std::vector<Term>& ts, double value,
+                                      const std::vector<std::vector<size_t>>& subsets,
+                                      const std::vector<std::array<double, 2>>& pair_read, int n,
+                                      std::vector<Reseeded>& found) {
+  const size_t J = ts.size();
+  constexpr size_t kNone = std::numeric_limits<size_t>::max();
+  struct PairStart {
+    size_t i, k;
+    Parameterization p;
+    Rotation4 R;
+    const std::vector<Term>* base;
+  };
+  // Powell from each start; the results join `found`.
+  const auto run_pairs = [&](const std::vector<PairStart>& starts) {
+    std::vector<Reseeded> pf(starts.size());
+    parallel_for(starts.size(), opt_.threads, [&](size_t q) {
+      const PairStart& st = starts[q];
+      const auto with = [&](const Rotation4& R) {
+        std::vector<Term> t = *st.base;
+        t[st.i] = Term{R, st.p};
+        t[st.k] = Term{swapped(R), st.p};
+        return t;
+      };
+      const auto objective = [&](const Rotation4& R) { return schedule(with(R.normalized()), nullptr, n); };
+      const PowellResult r = powell_minimize(objective, st.R, opt_.powell);
+      pf[q].ts = with(r.best.normalized());
+      pf[q].value = r.value;
+      pf[q].fits = r.evaluations;
+    });
+    size_t best = kNone;
+    for (const Reseeded& f : pf) {
+      found.push_back(f);
+      if (std::isfinite(f.value) && (best == kNone || f.value < found[best].value)) best = found.size() - 1;
+    }
+    return best;  // the lowest result's index in found (kNone if none)
+  };
+  std::vector<size_t> picks(2, subsets.size());
+  std::vector<PairStart> starts;
+  for (Parameterization p : params_) {
+    size_t& pick = picks[pidx(p)];
+    for (size_t si = 0; si < subsets.size(); ++si)
+      if (subsets[si].size() == 2 && pair_read[si][pidx(p)] < kPairRestartWithin * value &&
+          (pick == subsets.size() || pair_read[si][pidx(p)] < pair_read[pick][pidx(p)]))
+        pick = si;
+    if (pick == subsets.size()) continue;
+    std::mt19937_64 rng(opt_.seed * 1000003ull + 0x9a17ull + pidx(p));
+    for (int r = 0; r < kPairRestarts; ++r)
+      starts.push_back({subsets[pick][0], subsets[pick][1], p, Rotation4::random(rng), &ts});
+  }
+  const size_t first = found.size();
+  const size_t best = run_pairs(starts);
+  // Four terms, two disjoint pairs (one per parameterization): when one
+  // pair is wrong the other pair's restarts cannot reach its true planes
+  // (their error is masked), so the other pair is restarted again on top
+  // of the first stage's lowest result.
+  if (J == 4 && best != kNone && picks[0] < subsets.size() && picks[1] < subsets.size()) {
+    const std::vector<size_t>&A = subsets[picks[0]], &B = subsets[picks[1]];
+    const bool disjoint = std::find(B.begin(), B.end(), A[0]) == B.end() &&
+                          std::find(B.begin(), B.end(), A[1]) == B.end();
+    if (disjoint) {
+      // The stage-1 starts are in order (p0's, then p1's): which pair moved.
+      const bool moved_p0 = best - first < static_cast<size_t>(kPairRestarts);
+      const Parameterization q = moved_p0 ? params_[1] : params_[0];
+      const std::vector<size_t>& other = moved_p0 ? B : A;
+      const std::vector<Term> base = found[best].ts;
+      std::mt19937_64 rng(opt_.seed * 1000003ull + 0x9a19ull + pidx(q));
+      std::vector<PairStart> again;
+      for (int r = 0; r < kPairRestarts; ++r) again.push_back({other[0], other[1], q, Rotation4::random(rng), &base});
+      run_pairs(again);
+    }
+  }
+}
+
+bool Structured::reseed_keep(std::vector<Term>& ts, double& value, std::vector<Reseeded>& found,
+                             const std::vector<size_t>& order, int n, const PowellOptions& fine,
+                             TermRecord* rec) {
+  // Which replacements are polished: the best one if it is already lower,
+  // and, for every other mix of parameterizations (number of wiwo terms),
+  // its best replacement if it is within 2x of now (a term moved to the
+  // other parameterization starts higher before the others adapt). Each is
+  // polished with one coarse sweep; the lowest, if below now, gets the full
+  // polish (coarse, then fine) and is kept if it stays lower.
+  std::vector<size_t> chosen;
+  if (!order.empty() && found[order[0]].value < value * (1 - 1e-6)) chosen.push_back(order[0]);
+  std::vector<int> seen = {wiwo_count(ts)};
+  for (size_t i : order) {
+    const int c = wiwo_count(found[i].ts);
+    if (std::find(seen.begin(), seen.end(), c) != seen.end()) continue;
+    seen.push_back(c);
+    if (found[i].value < 2 * value && std::find(chosen.begin(), chosen.end(), i) == chosen.end())
+      chosen.push_back(i);
+  }
+  for (size_t i : chosen) polish(found[i].ts, found[i].value, 0, 1, n, rec, opt_.powell);
+  bool moved = false;
+  std::vector<Term> best_ts = ts;
+  double best = value;
+  size_t pick = found.size();
+  for (size_t i : chosen)
+    if (found[i].value < value * (1 - 1e-6) && (pick == found.size() || found[i].value < found[pick].value)) pick = i;
+  if (pick < found.size()) {
+    Reseeded& f = found[pick];
+    polish(f.ts, f.value, 0, opt_.polish_sweeps, n, rec, opt_.powell);
+    polish(f.ts, f.value, 0, opt_.polish_sweeps, n, rec, fine);
+    if (f.value < best * (1 - 1e-6)) {
+      best = f.value;
+      best_ts = f.ts;
+      moved = true;
+    }
+  }
+  if (moved) ts = best_ts;
+  return moved;
+}
+
 void Structured::reseed(std::vector<Term>& ts, double& value, TermRecord* rec) {
   const double t0 = now_seconds();
   const size_t J = ts.size();
@@ -523,185 +723,17 @@ void Structured::reseed(std::vector<Term>& ts, double& value, TermRecord* rec) {
   fine.initial_step = 0.05;
   fine.ftol = 1e-6;
   for (int round = 0; round < 4; ++round) {
-    struct Found {
-      std::vector<Term> ts;
-      double value = kInf;
-      int fits = 0;
-    };
-    std::vector<Found> found(subsets.size());
-    // The joint objective of each pair's first replacement, per parameterization.
-    std::vector<std::array<double, 2>> pair_read(subsets.size(), {kInf, kInf});
-    parallel_for(subsets.size(), opt_.threads, [&](size_t si) {
-      const std::vector<size_t>& S = subsets[si];
-      Found& f = found[si];
-      std::vector<Term> cur = ts;
-      std::vector<FactorTerm> cdone = done;
-      double cv = value;
-      for (int it = 0; it < 3; ++it) {
-        std::vector<FactorTerm> others;
-        for (size_t i = 0; i < J; ++i)
-          if (std::find(S.begin(), S.end(), i) == S.end()) others.push_back(cdone[i]);
-        std::vector<Term> best_ts;
-        std::vector<FactorTerm> best_done;
-        double best = kInf;
-        for (const auto& [p, sp] : seeds(residual(others))) {
-          std::vector<std::vector<Term>> trials;
-          if (S.size() == 2) {
-            trials.push_back(cur);
-            trials.back()[S[0]] = Term{sp.first, p};
-            trials.back()[S[1]] = Term{sp.second, p};
-          } else {
-            trials.push_back(cur);
-            trials.back()[S[0]] = Term{sp.first, p};
-            trials.push_back(cur);
-            trials.back()[S[0]] = Term{sp.second, p};
-          }
-          for (std::vector<Term>& t : trials) {
-            std::vector<FactorTerm> td;
-            const double v = schedule(t, &td, n);
-            ++f.fits;
-            if (it == 0 && S.size() == 2) pair_read[si][pidx(p)] = v;
-            if (v < best) {
-              best = v;
-              best_ts = std::move(t);
-              best_done = std::move(td);
-            }
-          }
-        }
-        if (it > 0 && !(best < cv * (1 - 1e-6))) break;
-        cur = std::move(best_ts);
-        cdone = std::move(best_done);
-        cv = best;
-        if (!std::isfinite(cv)) break;
-      }
-      f.ts = cur;
-      f.value = cv;
-    });
+    std::vector<std::array<double, 2>> pair_read;
+    std::vector<Reseeded> found = reseed_replacements(ts, done, value, subsets, n, pair_read);
+    if (round == 0) reseed_pair_restarts(ts, value, subsets, pair_read, n, found);
     std::vector<size_t> order(found.size());
     for (size_t i = 0; i < order.size(); ++i) order[i] = i;
     std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return found[a].value < found[b].value; });
-    // Pair restarts (first round): two terms of one parameterization may sit
-    // in a mixed local minimum (each plane part of both true planes) that no
-    // move of one term, and no Powell over their common frame from the
-    // current pair or from the residual's split, leaves (planted mixed member
-    // 1, halfdiff). In each parameterization p, the pair whose replacement by
-    // the residual's split in p is lowest (within kPairRestartWithin of now)
-    // is searched as one frame (plane A and its orthogonal complement) under
-    // the joint objective from kPairRestarts random frames; the results
-    // compete with the replacements below. The screened value of a random
-    // frame does not predict which one reaches the true pair (measured), so
-    // every start gets a Powell run.
-    if (round == 0) {
-      constexpr size_t kNone = std::numeric_limits<size_t>::max();
-      struct PairStart {
-        size_t i, k;
-        Parameterization p;
-        Rotation4 R;
-        const std::vector<Term>* base;
-      };
-      // Powell from each start; the results join `found`.
-      const auto run_pairs = [&](const std::vector<PairStart>& starts) {
-        std::vector<Found> pf(starts.size());
-        parallel_for(starts.size(), opt_.threads, [&](size_t q) {
-          const PairStart& st = starts[q];
-          const auto with = [&](const Rotation4& R) {
-            std::vector<Term> t = *st.base;
-            t[st.i] = Term{R, st.p};
-            t[st.k] = Term{swapped(R), st.p};
-            return t;
-          };
-          const auto objective = [&](const Rotation4& R) { return schedule(with(R.normalized()), nullptr, n); };
-          const PowellResult r = powell_minimize(objective, st.R, opt_.powell);
-          pf[q].ts = with(r.best.normalized());
-          pf[q].value = r.value;
-          pf[q].fits = r.evaluations;
-        });
-        size_t best = kNone;
-        for (const Found& f : pf) {
-          found.push_back(f);
-          if (std::isfinite(f.value) && (best == kNone || f.value < found[best].value)) best = found.size() - 1;
-        }
-        return best;  // the lowest result's index in found (kNone if none)
-      };
-      std::vector<size_t> picks(2, subsets.size());
-      std::vector<PairStart> starts;
-      for (Parameterization p : params_) {
-        size_t& pick = picks[pidx(p)];
-        for (size_t si = 0; si < subsets.size(); ++si)
-          if (subsets[si].size() == 2 && pair_read[si][pidx(p)] < kPairRestartWithin * value &&
-              (pick == subsets.size() || pair_read[si][pidx(p)] < pair_read[pick][pidx(p)]))
-            pick = si;
-        if (pick == subsets.size()) continue;
-        std::mt19937_64 rng(opt_.seed * 1000003ull + 0x9a17ull + pidx(p));
-        for (int r = 0; r < kPairRestarts; ++r)
-          starts.push_back({subsets[pick][0], subsets[pick][1], p, Rotation4::random(rng), &ts});
-      }
-      const size_t first = found.size();
-      const size_t best = run_pairs(starts);
-      // Four terms, two disjoint pairs (one per parameterization): when one
-      // pair is wrong the other pair's restarts cannot reach its true planes
-      // (their error is masked), so the other pair is restarted again on top
-      // of the first stage's lowest result.
-      if (J == 4 && best != kNone && picks[0] < subsets.size() && picks[1] < subsets.size()) {
-        const std::vector<size_t>&A = subsets[picks[0]], &B = subsets[picks[1]];
-        const bool disjoint = std::find(B.begin(), B.end(), A[0]) == B.end() &&
-                              std::find(B.begin(), B.end(), A[1]) == B.end();
-        if (disjoint) {
-          // The stage-1 starts are in order (p0's, then p1's): which pair moved.
-          const bool moved_p0 = best - first < static_cast<size_t>(kPairRestarts);
-          const Parameterization q = moved_p0 ? params_[1] : params_[0];
-          const std::vector<size_t>& other = moved_p0 ? B : A;
-          const std::vector<Term> base = found[best].ts;
-          std::mt19937_64 rng(opt_.seed * 1000003ull + 0x9a19ull + pidx(q));
-          std::vector<PairStart> again;
-          for (int r = 0; r < kPairRestarts; ++r) again.push_back({other[0], other[1], q, Rotation4::random(rng), &base});
-          run_pairs(again);
-        }
-      }
-      order.resize(found.size());
-      for (size_t i = 0; i < order.size(); ++i) order[i] = i;
-      std::stable_sort(order.begin(), order.end(),
-                       [&](size_t a, size_t b) { return found[a].value < found[b].value; });
-    }
-    for (const Found& f : found) {
+    for (const Reseeded& f : found) {
       evaluations_ += f.fits;
       rec->backfit_evaluations += f.fits;
     }
-    // Which replacements are polished: the best one if it is already lower,
-    // and, for every other mix of parameterizations (number of wiwo terms),
-    // its best replacement if it is within 2x of now (a term moved to the
-    // other parameterization starts higher before the others adapt). Each is
-    // polished with one coarse sweep; the lowest, if below now, gets the full
-    // polish (coarse, then fine) and is kept if it stays lower.
-    std::vector<size_t> chosen;
-    if (!order.empty() && found[order[0]].value < value * (1 - 1e-6)) chosen.push_back(order[0]);
-    std::vector<int> seen = {wiwo_count(ts)};
-    for (size_t i : order) {
-      const int c = wiwo_count(found[i].ts);
-      if (std::find(seen.begin(), seen.end(), c) != seen.end()) continue;
-      seen.push_back(c);
-      if (found[i].value < 2 * value && std::find(chosen.begin(), chosen.end(), i) == chosen.end())
-        chosen.push_back(i);
-    }
-    for (size_t i : chosen) polish(found[i].ts, found[i].value, 0, 1, n, rec, opt_.powell);
-    bool moved = false;
-    std::vector<Term> best_ts = ts;
-    double best = value;
-    size_t pick = found.size();
-    for (size_t i : chosen)
-      if (found[i].value < value * (1 - 1e-6) && (pick == found.size() || found[i].value < found[pick].value)) pick = i;
-    if (pick < found.size()) {
-      Found& f = found[pick];
-      polish(f.ts, f.value, 0, opt_.polish_sweeps, n, rec, opt_.powell);
-      polish(f.ts, f.value, 0, opt_.polish_sweeps, n, rec, fine);
-      if (f.value < best * (1 - 1e-6)) {
-        best = f.value;
-        best_ts = f.ts;
-        moved = true;
-      }
-    }
-    if (!moved) break;
-    ts = best_ts;
+    if (!reseed_keep(ts, value, found, order, n, fine, rec)) break;
     value = schedule(ts, &done, n);
     ++evaluations_;
     ++rec->backfit_evaluations;

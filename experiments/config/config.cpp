@@ -329,6 +329,32 @@ void read_fill(Reader& r, SamplingVariant& s) {
   if (s.fill < 0) s.identity["fill_share"] = kFillShare;
 }
 
+// The keys of measured samplings: `weights` (brdfs/measured.h) and `fill`
+// (experiments/run/symmetry_prep.h); refused for other kinds, naming the key.
+void read_measured_keys(Reader& r, SamplingVariant& s) {
+  // Sample weights of measured data (brdfs/measured.h): "auto" weights a MERL
+  // table's cells by their measure, leaves scattered samples unweighted. In
+  // the identity of every measured set (its results depend on it).
+  if (r.has("weights") && s.kind != "measured") {
+    r.fail("weights", "applies to kind = \"measured\" only (a table's cell weights), found kind = \"" +
+                          s.kind + "\"");
+    r.take("weights");
+  } else if (s.kind == "measured") {
+    s.weights = r.choice("weights", "auto", {"auto", "measure", "none"});
+    s.identity["weights"] = s.weights;
+    if (s.weights != "auto") s.label += " weights " + s.weights;
+  }
+  // The whole-domain fill of raw samples (experiments/run/symmetry_prep.h):
+  // "auto", "off" or a share of the fit's weight in (0, 0.9].
+  if (r.has("fill") && s.kind != "measured") {
+    r.fail("fill", "applies to kind = \"measured\" only (a measured BRDF's interpolant fills the domain), "
+                   "found kind = \"" + s.kind + "\"");
+    r.take("fill");
+  } else if (s.kind == "measured") {
+    read_fill(r, s);
+  }
+}
+
 void read_samplings(const toml::node* node, Ctx& ctx, uint64_t base_seed,
                     std::vector<SamplingVariant>& out) {
   std::vector<const toml::table*> tables;
@@ -415,27 +441,7 @@ void read_samplings(const toml::node* node, Ctx& ctx, uint64_t base_seed,
         if (s.symmetries != "off" && s.symmetries != "none") s.identity["orbit"] = orbit_identity();
       }
       if (s.symmetries != "auto") s.label += " symmetries " + s.symmetries;
-      // Sample weights of measured data (brdfs/measured.h): "auto" weights a MERL
-      // table's cells by their measure, leaves scattered samples unweighted. In
-      // the identity of every measured set (its results depend on it).
-      if (r.has("weights") && s.kind != "measured") {
-        r.fail("weights", "applies to kind = \"measured\" only (a table's cell weights), found kind = \"" +
-                              s.kind + "\"");
-        r.take("weights");
-      } else if (s.kind == "measured") {
-        s.weights = r.choice("weights", "auto", {"auto", "measure", "none"});
-        s.identity["weights"] = s.weights;
-        if (s.weights != "auto") s.label += " weights " + s.weights;
-      }
-      // The whole-domain fill of raw samples (experiments/run/symmetry_prep.h):
-      // "auto", "off" or a share of the fit's weight in (0, 0.9].
-      if (r.has("fill") && s.kind != "measured") {
-        r.fail("fill", "applies to kind = \"measured\" only (a measured BRDF's interpolant fills the domain), "
-                       "found kind = \"" + s.kind + "\"");
-        r.take("fill");
-      } else if (s.kind == "measured") {
-        read_fill(r, s);
-      }
+      read_measured_keys(r, s);
       for (const auto& key : {"resolution", "count", "seed", "path"}) {
         if (!r.has(key) || contains(sampling_keys_of(s.kind), key)) continue;
         if (kind_swept && sweep_keys.count(key)) {
