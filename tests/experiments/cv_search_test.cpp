@@ -12,23 +12,12 @@
 #include "experiments/methods/homomorphic.h"
 #include "experiments/report/outputs.h"
 #include "experiments_helpers.h"
+#include "normal_stream.h"
 
 using namespace bf;
 using namespace bf_test;
 
 namespace {
-
-// A portable standard normal stream (SplitMix64 + Box-Muller).
-struct Normal {
-  uint64_t x;
-  double uniform() {
-    uint64_t z = (x += 0x9e3779b97f4a7c15ULL);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-    return (double((z ^ (z >> 31)) >> 11) + 0.5) / 9007199254740992.0;
-  }
-  double operator()() { return std::sqrt(-2 * std::log(uniform())) * std::cos(6.283185307179586 * uniform()); }
-};
 
 // n samples of a smooth BRDF with log-normal noise sigma per channel, as a CSV.
 std::string noisy_csv(const ScratchDir& tmp, const std::string& brdf, size_t n, double sigma) {
