@@ -143,6 +143,8 @@ TEST_CASE("fill: on raw Cornell samples the fit follows the interpolant off the 
   CHECK(rec.at("fill").at("used") == true);
   CHECK(rec.at("fill").at("pairs") == kFillPairs);
   CHECK(rec.at("fill").at("share") == kFillShare);
+  // The fill's truth is the interpolant of the 1,295 training samples, never of the held-out ones.
+  CHECK_THAT(rec.at("fill").at("truth").get<std::string>(), Catch::Contains("1295 valid samples"));
   const nlohmann::json rec_off =
       nlohmann::json::parse(read_text(tmp / ("off/runs/" + off.at("run_id") + "/run.json")));
   CHECK(rec_off.at("fill").at("used") == false);
