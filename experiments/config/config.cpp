@@ -312,13 +312,10 @@ std::vector<std::string> sampling_keys_of(const std::string& kind) {
 // sampling.fill of kind "measured": "auto" (-1), "off" (0) or a share in
 // (0, 0.9]; in the identity (results depend on it), in the label when set.
 void read_fill(Reader& r, SamplingVariant& s) {
-  if (const toml::node* n = r.combo().count("fill") ? r.combo().at("fill") : nullptr; n && n->is_string()) {
-    const std::string v = r.choice("fill", "auto", {"auto", "off"});
-    s.fill = v == "off" ? 0.0 : -1.0;
-  } else if (n) {
+  if (r.has("fill") && r.combo().at("fill")->is_string())
+    s.fill = r.choice("fill", "auto", {"auto", "off"}) == "off" ? 0.0 : -1.0;
+  else if (r.has("fill"))
     s.fill = r.number("fill", -1.0, 0.0, 0.9);
-    if (s.fill == 0.0) s.fill = 0.0;
-  }
   if (s.fill < 0) {
     s.identity["fill"] = "auto";
   } else {

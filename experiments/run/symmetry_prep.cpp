@@ -3,7 +3,6 @@
 #include <cmath>
 #include <stdexcept>
 
-
 namespace bf {
 
 SymmetryChoice choose_symmetries(const SamplingVariant& s, const SampleSet& samples) {
