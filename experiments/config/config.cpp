@@ -102,7 +102,17 @@ ExperimentSettings read_experiment(const toml::table* t, Ctx& ctx, const std::st
   e.metric_eps = r.number("metric_eps", 1e-5, 0.0, 1.0, true);
   e.validation_pairs = static_cast<int>(r.integer("validation_pairs", e.validation_pairs, 0, 1000000));
   e.holdout = r.number("holdout", e.holdout, 0.0, 0.5, false);
-  e.folds = static_cast<int>(r.integer("folds", 0, 0, 1000000));
+  // Default: auto (5 folds on small raw sample sets), unless the single
+  // fraction is chosen by setting `holdout`.
+  if (r.has("folds") && r.combo().at("folds")->is_string()) {
+    r.choice("folds", "auto", {"auto"});
+    if (r.has("holdout"))
+      r.fail("folds", "folds = \"auto\" chooses between folds and the single fraction, but holdout = " +
+                          format_number(e.holdout) + " is set too: expected one of them");
+    e.folds = ExperimentSettings::kFoldsAuto;
+  } else {
+    e.folds = static_cast<int>(r.integer("folds", r.has("holdout") ? 0 : ExperimentSettings::kFoldsAuto, 0, 1000000));
+  }
   if (e.folds == 1)
     r.fail("folds", "expected 0 (off: the single `holdout` fraction) or a number of folds >= 2, found 1");
   else if (e.folds >= 2 && r.has("holdout"))
@@ -431,7 +441,7 @@ void read_samplings(const toml::node* node, Ctx& ctx, uint64_t base_seed,
                                "reciprocal, bilateral), found \"" + s.symmetries + "\"");
         }
       }
-      if (s.kind == "measured" || s.kind == "file" || s.symmetries != "auto") {
+      if (s.raw() || s.symmetries != "auto") {
         s.identity["symmetries"] = s.symmetries;
         // The orbit's settings are code constants: in the identity, so that
         // changing them never reuses a run cached under the old ones.
@@ -564,6 +574,23 @@ static void check_plan_size_before_expanding(const toml::table& root, const std:
                      n(m) + " method combinations; nothing was expanded"});
 }
 
+// What every run of a plan shares in its identity: the format version and
+// the experiment settings its results depend on.
+static json identity_common(const Plan& plan) {
+  json common = {{"v", kRunFormatVersion},
+                 {"metric_eps", plan.experiment.metric_eps},
+                 {"render", plan.experiment.render},
+                 {"export", plan.experiment.export_factors},
+                 {"scene", plan.scene.identity()},
+                 {"validation", {{"pairs", plan.experiment.validation_pairs},
+                                 {"holdout", plan.experiment.holdout},
+                                 {"seed", validation_seed(plan.experiment.seed)}}}};
+  // Only when on: runs without folds keep their ids. "auto" enters only the
+  // ids of runs on raw samples (parse_plan), the only ones it can change.
+  if (plan.experiment.folds > 0) common["validation"]["folds"] = plan.experiment.folds;
+  return common;
+}
+
 Plan parse_plan(const std::string& text, const std::string& path, const std::vector<std::string>& defines) {
   Ctx ctx;
   ctx.path = path;
@@ -642,16 +669,7 @@ Plan parse_plan(const std::string& text, const std::string& path, const std::vec
   }
   if (!ctx.issues.empty()) throw ConfigError(ctx.issues);
 
-  json common = {{"v", kRunFormatVersion},
-                       {"metric_eps", plan.experiment.metric_eps},
-                       {"render", plan.experiment.render},
-                       {"export", plan.experiment.export_factors},
-                       {"scene", plan.scene.identity()},
-                       {"validation", {{"pairs", plan.experiment.validation_pairs},
-                                       {"holdout", plan.experiment.holdout},
-                                       {"seed", validation_seed(plan.experiment.seed)}}}};
-  // Only when on: runs without folds keep their ids.
-  if (plan.experiment.folds > 0) common["validation"]["folds"] = plan.experiment.folds;
+  const json common = identity_common(plan);
   std::set<std::string> ids;
   json all = json::array();
   for (size_t b = 0; b < plan.brdfs.size(); ++b)
@@ -667,6 +685,8 @@ Plan parse_plan(const std::string& text, const std::string& path, const std::vec
         r.identity = common;
         r.identity["brdf"] = plan.brdfs[b].identity;
         r.identity["sampling"] = plan.samplings[s].identity;
+        if (plan.experiment.folds == ExperimentSettings::kFoldsAuto && plan.samplings[s].raw())
+          r.identity["validation"]["folds"] = "auto";
         r.identity["method"] = plan.methods[m].options;
         r.run_id = short_hash(r.identity);
         if (!ids.insert(r.run_id).second) {

@@ -53,8 +53,14 @@ struct ExperimentSettings {
   double holdout = 0.1;
   // k-fold hold-out instead of the single fraction (experiments/run/folds.h):
   // 0 = off; k >= 2 fits each method k times without one fold each, and the
-  // run's own fit on every sample.
-  int folds = 0;
+  // run's own fit on every sample; kFoldsAuto (the default when neither
+  // `folds` nor `holdout` is set): kAutoFolds folds on raw samples of at most
+  // kAutoFoldsMaxSamples valid samples, else the single fraction
+  // (folds_for, experiments/report/validation.h).
+  int folds = kFoldsAuto;
+  static constexpr int kFoldsAuto = -1;
+  static constexpr int kAutoFolds = 5;
+  static constexpr size_t kAutoFoldsMaxSamples = 20000;
 };
 
 // The seed of the validation set and of the held-out choice, derived from
@@ -114,6 +120,8 @@ inline nlohmann::json orbit_identity() {
 
 struct SamplingVariant {
   std::string kind;         // "grid" | "stratified" | "file" | "measured"
+  // Raw samples (measured, file): held out, fitted with their symmetries.
+  bool raw() const { return kind == "measured" || kind == "file"; }
   int resolution = 16;      // grid: res^4 parabolic grid
   uint64_t count = 0;       // stratified: pairs
   uint64_t seed = 1;        // stratified

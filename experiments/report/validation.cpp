@@ -28,7 +28,15 @@ HoldoutSplit partition_held(const SampleSet& s, const std::vector<uint8_t>& held
 }
 
 bool holds_out(const SamplingVariant& s, const ExperimentSettings& e) {
-  return e.holdout > 0.0 && (s.kind == "measured" || s.kind == "file");
+  return e.holdout > 0.0 && s.raw();
+}
+
+int folds_for(const SamplingVariant& s, const ExperimentSettings& e, size_t valid_samples) {
+  if (!s.raw()) return 0;
+  if (e.folds == ExperimentSettings::kFoldsAuto)
+    return e.holdout > 0.0 && valid_samples <= ExperimentSettings::kAutoFoldsMaxSamples ? ExperimentSettings::kAutoFolds
+                                                                                     : 0;
+  return e.folds >= 2 ? e.folds : 0;
 }
 
 HoldoutSplit split_holdout(const SampleSet& s, double fraction, uint64_t seed) {

@@ -33,6 +33,13 @@ inline constexpr double kFlagMaxRatio = 10.0;
 // kind "measured" or "file") when experiment.holdout > 0.
 bool holds_out(const SamplingVariant& s, const ExperimentSettings& e);
 
+// The number of folds a run on this sampling uses, 0 for none (the single
+// fraction, or nothing held out): experiment.folds when set (k >= 2) on raw
+// samples; with folds = "auto" (the default), kAutoFolds when the samples
+// have at most kAutoFoldsMaxSamples valid samples, where a 10% fraction holds
+// out too few to measure (for 1,439 Cornell samples, 144), else 0.
+int folds_for(const SamplingVariant& s, const ExperimentSettings& e, size_t valid_samples);
+
 // The fit's samples and the held-out ones: round(fraction x valid samples)
 // valid samples chosen by a seeded shuffle (deterministic for a seed, the
 // same on every platform); masked samples stay in `train` (masked). Weights

@@ -137,7 +137,12 @@ std::string validation_scheme(const Plan& plan, const BrdfVariant& b, const Samp
     parts.push_back("held out: " + std::to_string(split->held.valid_count()) + " of " + std::to_string(all_valid) +
                     " samples (" + format_number(plan.experiment.holdout * 100.0) + "%), not fitted");
   if (folds)
-    parts.push_back("held out: " + std::to_string(folds->folds) + "-fold (seed " +
+    parts.push_back("held out: " + std::to_string(folds->folds) + "-fold (" +
+                    (plan.experiment.folds == ExperimentSettings::kFoldsAuto
+                         ? "folds = \"auto\": at most " + std::to_string(ExperimentSettings::kAutoFoldsMaxSamples) +
+                               " valid samples; "
+                         : std::string()) +
+                    "seed " +
                     std::to_string(validation_seed(plan.experiment.seed)) + "), each of " +
                     std::to_string(all_valid) + " samples held out once; holdout_* are the mean over the folds (" +
                     folds->spread() + "); the scored fit uses every sample");
@@ -216,8 +221,9 @@ HeldOutData held_out_data(const Plan& plan, const PlannedRun& pr, const SampleSe
   HeldOutData d;
   const SamplingVariant& s = plan.samplings[pr.sampling];
   const uint64_t seed = validation_seed(plan.experiment.seed);
-  if (plan.experiment.folds >= 2 && holds_out(s, ExperimentSettings{}))
-    d.folds = split_folds(samples, plan.experiment.folds, seed);
+  const int k = folds_for(s, plan.experiment, samples.valid_count());
+  if (k >= 2)
+    d.folds = split_folds(samples, k, seed);
   else if (holds_out(s, plan.experiment))
     d.split = split_holdout(samples, plan.experiment.holdout, seed);
   return d;
@@ -325,7 +331,7 @@ HeldOutStage held_out_stage(const Plan& plan, const PlannedRun& pr, const Method
       per_candidate.push_back(std::move(sc));
     }
     const double chosen = m.cv->ladder[best];
-    const std::string by = use_folds ? std::to_string(plan.experiment.folds) + "-fold mean held-out rel_mse"
+    const std::string by = use_folds ? std::to_string(folds->size()) + "-fold mean held-out rel_mse"
                                      : "held-out rel_mse of the held-out fraction";
     m.cv->apply(m, chosen);
     if (use_folds) chosen_folds = per_candidate[best];

@@ -35,7 +35,7 @@ TEST_CASE("baselines never see held-out samples - perturbing only them leaves sv
   write_sample_csv(perturbed, bad);
 
   auto config = [&](const std::string& csv) {
-    return "[experiment]\nseed = 5\nplots = false\nrender = false\nexport = false\n"
+    return "[experiment]\nseed = 5\nholdout = 0.1\nplots = false\nrender = false\nexport = false\n"
            "[[brdf]]\nfile = \"" + csv + "\"\n[sampling]\nkind = \"measured\"\n"
            "[[method]]\nkind = \"svd\"\nterms = 2\ntexture_size = 6\n"
            "[[method]]\nkind = \"sh-k\"\norder = 3\ntexture_size = 6\n";

@@ -10,6 +10,7 @@
 #include "brdfs/catalogue.h"
 #include "brdfs/sample_csv.h"
 #include "experiments/report/outputs.h"
+#include "experiments/report/validation.h"
 #include "experiments/run/folds.h"
 #include "experiments_helpers.h"
 
@@ -116,6 +117,65 @@ TEST_CASE("kfold: config rejects folds = 1 and folds with an explicit holdout") 
   CHECK(a.runs[0].run_id != b.runs[0].run_id);
   CHECK(b.runs[0].run_id != c.runs[0].run_id);
   CHECK(!a.runs[0].identity["validation"].contains("folds"));
+}
+
+TEST_CASE("kfold: folds = auto holds out 5 folds of small raw sets and the single fraction of large ones") {
+  // The rule (experiments/report/validation.h folds_for).
+  SamplingVariant raw, grid;
+  raw.kind = "measured";
+  grid.kind = "grid";
+  const ExperimentSettings autoset;  // the defaults: folds = "auto", holdout 0.1
+  REQUIRE(autoset.folds == ExperimentSettings::kFoldsAuto);
+  CHECK(folds_for(raw, autoset, 1439) == 5);
+  CHECK(folds_for(raw, autoset, ExperimentSettings::kAutoFoldsMaxSamples) == 5);
+  CHECK(folds_for(raw, autoset, ExperimentSettings::kAutoFoldsMaxSamples + 1) == 0);
+  CHECK(folds_for(raw, autoset, 986594) == 0);
+  CHECK(folds_for(grid, autoset, 1439) == 0);
+  ExperimentSettings three = autoset, single = autoset;
+  three.folds = 3;
+  single.folds = 0;
+  CHECK(folds_for(raw, three, 986594) == 3);
+  CHECK(folds_for(raw, single, 1439) == 0);
+
+  // The config: "auto" is the default, setting holdout chooses the single
+  // fraction, "auto" with holdout or another word is refused.
+  register_loaders();
+  const std::string head = std::string(kConfigHead) + "[[method]]\nkind = \"mccool\"\ntexture_size = 4\n";
+  auto with = [&](const std::string& exp) {
+    std::string t = head;
+    t.replace(t.find("name = \"t\"\n"), 11, "name = \"t\"\n" + exp);
+    return t;
+  };
+  CHECK(parse_plan(with(""), "cfg.toml", {}).experiment.folds == ExperimentSettings::kFoldsAuto);
+  CHECK(parse_plan(with("folds = \"auto\"\n"), "cfg.toml", {}).experiment.folds == ExperimentSettings::kFoldsAuto);
+  CHECK(parse_plan(with("holdout = 0.1\n"), "cfg.toml", {}).experiment.folds == 0);
+  CHECK(parse_plan(with("folds = 0\n"), "cfg.toml", {}).experiment.folds == 0);
+  require_one_config_error(with("folds = \"auto\"\nholdout = 0.2\n"), {"experiment.folds", "auto", "holdout"});
+  require_one_config_error(with("folds = \"some\"\n"), {"experiment.folds", "auto", "some"});
+
+  // A run on a small raw set: 5 folds by default, the single 10% fraction
+  // when holdout is set; "auto" is in the identity of raw-sample runs only.
+  ScratchDir tmp;
+  const BrdfPtr bp = Catalogue::builtin().make("bluepaint");
+  const std::string csv = tmp / "s.csv";
+  write_sample_csv(sample_stratified(*bp, 200, 4), csv);
+  const std::string body = "plots = false\nrender = false\nexport = false\nvalidation_pairs = 0\n"
+                           "[[brdf]]\nfile = \"" + csv + "\"\n[sampling]\nkind = \"measured\"\n"
+                           "[[method]]\nkind = \"mccool\"\ntexture_size = 6\n";
+  run_quiet(write_text(tmp / "a.toml", "[experiment]\n" + body), tmp / "a");
+  run_quiet(write_text(tmp / "b.toml", "[experiment]\nholdout = 0.1\n" + body), tmp / "b");
+  const auto ra = read_results_csv(tmp / "a/results.csv"), rb = read_results_csv(tmp / "b/results.csv");
+  REQUIRE(ra.size() == 1);
+  REQUIRE(rb.size() == 1);
+  INFO(ra[0].at("validation") << " | " << rb[0].at("validation"));
+  CHECK(ra[0].at("validation").find("5-fold (folds = \"auto\"") != std::string::npos);
+  CHECK(ra[0].at("samples") == "200");  // the scored fit uses every sample
+  CHECK(rb[0].at("validation").find("held out: 20 of 200 samples (10%)") != std::string::npos);
+  CHECK(rb[0].at("samples") == "180");
+  CHECK(ra[0].at("run_id") != rb[0].at("run_id"));
+  CHECK(parse_plan("[experiment]\n" + body, tmp / "c.toml", {})
+            .runs[0].identity["validation"]["folds"] == "auto");
+  CHECK(!parse_plan(with(""), "cfg.toml", {}).runs[0].identity["validation"].contains("folds"));
 }
 
 TEST_CASE("kfold: a run reports the mean held-out error over folds and fits every sample") {

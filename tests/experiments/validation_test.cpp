@@ -114,7 +114,7 @@ TEST_CASE("validation: held-out samples are never fitted - perturbing only them 
   const std::string perturbed = write_text(tmp / "perturbed.csv", lines_of(lines));
 
   auto config = [&](const std::string& csv) {
-    return "[experiment]\nseed = 5\nplots = false\nrender = false\nexport = false\n"
+    return "[experiment]\nseed = 5\nholdout = 0.1\nplots = false\nrender = false\nexport = false\n"
            "[[brdf]]\npreset = \"bluepaint\"\n[sampling]\nkind = \"file\"\npath = \"" + csv +
            "\"\n[[method]]\nkind = \"mccool\"\ntexture_size = 6\n";
   };
