@@ -209,6 +209,29 @@ struct HeldOutStage {
   std::string cv_note;               // with a key chosen by held-out error: the choice in words
 };
 
+// What every fit of a run is given (the run's own fit and each held-out
+// fit): the BRDF, for a measured one fitted without held-out samples the BRDF
+// made of its training samples only (the tabulating kinds read it, the fill
+// samples it, so no held-out sample reaches a fit), the whole-domain fill, and
+// the fit set (the training samples' orbit plus the fill).
+struct FitPrep {
+  BrdfVariant brdf;
+  FillChoice fill;  // fill.truth points into brdf's shared BRDF
+  SampleSet view;
+};
+FitPrep prepare_fit(const Plan& plan, const PlannedRun& pr, const SampleSet& train, bool held_out,
+                    const SymmetryChoice& sym, OrbitInfo* orbit) {
+  FitPrep p{plan.brdfs[pr.brdf], {}, {}};
+#ifdef BF_RUNNER_HAVE_MEASURED
+  if (held_out && p.brdf.measured)
+    if (BrdfPtr t = measured_from_training(*p.brdf.brdf, train)) p.brdf.brdf = std::move(t);
+#endif
+  p.fill = choose_fill(plan.samplings[pr.sampling], p.brdf.measured ? p.brdf.brdf.get() : nullptr, sym,
+                       fill_seed(plan.experiment.seed));
+  p.view = with_fill(fit_set(train, sym, orbit), p.fill);
+  return p;
+}
+
 // The held-out data of a run on raw samples (experiments/report/validation.h,
 // experiments/run/folds.h): a fraction held out of the fit, or with
 // experiment.folds the k folds, fitted separately (nothing is held out of the
@@ -258,14 +281,9 @@ HeldOutStage held_out_stage(const Plan& plan, const PlannedRun& pr, const Method
   // the tabulating kinds, scene weights), scored on them.
   auto held_out_score = [&](const HoldoutSplit& h, const MethodVariant& mv) {
     const LogTransform flt = LogTransform::of(h.train, plan.experiment.metric_eps);
-    BrdfVariant fb = b;
-#ifdef BF_RUNNER_HAVE_MEASURED
-    if (b.measured)
-      if (BrdfPtr t = measured_from_training(*b.brdf, h.train)) fb.brdf = std::move(t);
-#endif
-    const SampleSet view = with_fill(fit_set(h.train, sym, nullptr),
-                                     choose_fill(plan.samplings[pr.sampling], b.measured ? fb.brdf.get() : nullptr, sym,
-                                                 fill_seed(plan.experiment.seed)));
+    const FitPrep prep = prepare_fit(plan, pr, h.train, true, sym, nullptr);
+    const BrdfVariant& fb = prep.brdf;
+    const SampleSet& view = prep.view;
     std::optional<SampleSet> wv;
     if (const auto wf = mv.options.find("weight_fit"); wf != mv.options.end())
       wv = scene_weighted(view, scene_pairs(*b.brdf, plan.scene), wf->at("floor").get<double>());
@@ -391,14 +409,10 @@ RunEntry execute_run(const Plan& plan, const PlannedRun& pr, const SampleSet& sa
   // Kinds that tabulate the BRDF (svd, sh-k, sh-r) see a measured BRDF made of
   // the training samples only, so their held-out columns are on unseen data;
   // the whole-domain fill reads the same training-only BRDF.
-  BrdfVariant fit_b = b;
-#ifdef BF_RUNNER_HAVE_MEASURED
-  if (split && b.measured)
-    if (BrdfPtr t = measured_from_training(*b.brdf, split->train)) fit_b.brdf = std::move(t);
-#endif
-  const FillChoice fill = choose_fill(plan.samplings[pr.sampling], b.measured ? fit_b.brdf.get() : nullptr, sym,
-                                      fill_seed(plan.experiment.seed));
-  const SampleSet fit_view = with_fill(fit_set(fit_samples, sym, &orbit), fill);
+  const FitPrep prep = prepare_fit(plan, pr, fit_samples, split.has_value(), sym, &orbit);
+  const BrdfVariant& fit_b = prep.brdf;
+  const FillChoice& fill = prep.fill;
+  const SampleSet& fit_view = prep.view;
   if (plan.samplings[pr.sampling].kind == "measured") rec["fill"] = fill.describe();
   row["symmetries"] = sym.used.to_string();
   rec["symmetries"] = {{"key", sym.key}, {"declared", sym.declared.to_string()}, {"used", sym.used.to_string()}};

@@ -11,7 +11,7 @@ SymmetryChoice choose_symmetries(const SamplingVariant& s, const SampleSet& samp
   c.declared = samples.symmetries;
   if (c.key == "off" || c.key == "none") return c;
   if (c.key == "auto") {
-    if (s.kind == "measured" || s.kind == "file") c.used = c.declared;
+    if (s.raw()) c.used = c.declared;
     return c;
   }
   // Validated when the config was read (config.cpp), so this does not throw there.
@@ -83,7 +83,13 @@ SampleSet with_fill(SampleSet fit, const FillChoice& f) {
     if (fit.valid[k]) total += fit.weight_of(k);
   const SampleSet pairs = sample_stratified(*f.truth, f.pairs, f.seed);
   const size_t n = pairs.valid_count();
-  if (n == 0 || !(total > 0.0)) return fit;
+  if (!(total > 0.0))
+    throw std::invalid_argument("sampling.fill: the fit set (" + fit.description +
+                                ") has no valid sample of positive weight to add the fill's share to");
+  if (n == 0)
+    throw std::invalid_argument("sampling.fill: none of the " + std::to_string(f.pairs) +
+                                " fill pairs has a value of the training BRDF (" + f.truth->name() +
+                                "): expected a BRDF that holds over the whole domain");
   // The fill's pairs carry `share` of the final total: w n = share (total + w n).
   const double w = f.share / (1.0 - f.share) * total / double(n);
   for (size_t k = 0; k < pairs.size(); ++k)

@@ -61,7 +61,9 @@ struct FillChoice {
 // thesis's); a share the user set needs a training BRDF that holds over the
 // whole domain, else std::invalid_argument naming sampling.fill.
 FillChoice choose_fill(const SamplingVariant& s, const Brdf* training, const SymmetryChoice& sym, uint64_t seed);
-// `fit` followed by the fill's pairs (fit itself when there is none).
+// `fit` followed by the fill's pairs (fit itself when there is none). Throws
+// std::invalid_argument naming sampling.fill when `fit` has no weight to take
+// a share of, or the truth gives no pair a value (never a silent no-fill).
 SampleSet with_fill(SampleSet fit, const FillChoice& f);
 
 }  // namespace bf

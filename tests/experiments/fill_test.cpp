@@ -93,14 +93,49 @@ TEST_CASE("fill: the training interpolant's pairs carry exactly the share of the
     CHECK((out.value[k] - truth->eval(out.wi[k], out.wo[k])).abs().maxCoeff() == 0.0);
   // The fill never samples the whole-domain validation pairs of the same experiment seed.
   const FillChoice g = choose_fill(measured_sampling(-1.0), truth.get(), kOrbit, fill_seed(3));
-  const SampleSet pairs = with_fill(SampleSet{}, g);
+  const SampleSet pairs = with_fill(fit, g);
+  REQUIRE(pairs.size() == 50 + kFillPairs);
   const SampleSet val = validation_set(*truth, 1024, validation_seed(3));
   std::set<std::pair<double, double>> seen;
   for (size_t k = 0; k < val.size(); ++k) seen.insert({val.wi[k].x(), val.wo[k].y()});
   size_t shared = 0;
-  for (size_t k = 0; k < pairs.size(); ++k) shared += seen.count({pairs.wi[k].x(), pairs.wo[k].y()});
+  for (size_t k = 50; k < pairs.size(); ++k) shared += seen.count({pairs.wi[k].x(), pairs.wo[k].y()});
   CHECK(shared == 0);
+  // A fill drawn like the validation set (its count and seed) is seen as a leak.
+  FillChoice same = g;
+  same.pairs = 1024;
+  same.seed = validation_seed(3);
+  const SampleSet leak = with_fill(fit, same);
+  size_t leaked = 0;
+  for (size_t k = 50; k < leak.size(); ++k) leaked += seen.count({leak.wi[k].x(), leak.wo[k].y()});
+  CHECK(leaked > 0);
   CHECK(fill_seed(3) != validation_seed(3));
+}
+
+namespace {
+// A BRDF with no value anywhere (every pair masked).
+class NowhereBrdf final : public Brdf {
+ public:
+  Rgb eval(const Vec3&, const Vec3&) const override { return Rgb::Constant(-1.0); }
+  std::string name() const override { return "nowhere"; }
+  std::string to_string() const override { return "nowhere"; }
+};
+}  // namespace
+
+TEST_CASE("fill: a fill with nothing to add refuses naming the key instead of fitting unfilled") {
+  SampleSet fit = sample_stratified(*Catalogue::builtin().make("lambert"), 50, 9);
+  NowhereBrdf nowhere;
+  FillChoice f;
+  f.truth = &nowhere;
+  f.share = kFillShare;
+  f.pairs = 256;
+  f.seed = 5;
+  CHECK_THROWS_WITH(with_fill(fit, f), Catch::Contains("sampling.fill") && Catch::Contains("none of the 256") &&
+                                           Catch::Contains("nowhere"));
+  const auto truth = declared_interpolant(true);
+  f.truth = truth.get();
+  CHECK_THROWS_WITH(with_fill(SampleSet{}, f), Catch::Contains("sampling.fill") && Catch::Contains("no valid sample"));
+  CHECK(with_fill(fit, f).size() == 50 + 256);
 }
 
 TEST_CASE("fill: auto leaves undeclared samples and fits without symmetries alone and a share set there is refused") {
