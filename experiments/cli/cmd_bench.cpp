@@ -719,7 +719,9 @@ void add_bench_search(CLI::App* bench) {
   auto b = std::make_shared<BenchSearchArgs>();
   search->add_option("--brdf", b->brdf, "catalogue name or measured file")->capture_default_str();
   search->add_option("--grid", b->grid, "regular res^4 parabolic grid")->capture_default_str();
-  search->add_option("--sampling", b->sampling, "grid (--grid) or measured (a measured BRDF's own samples)")
+  search->add_option("--sampling", b->sampling, "grid (--grid) or measured (a measured BRDF's own samples: the "
+                      "records alone, no orbit, weights or fill, as the thesis fitted "
+                      "them; `run` adds them)")
       ->check(CLI::IsMember({"grid", "measured"}))
       ->capture_default_str();
   search->add_option("--texture", b->texture, "final texture resolution")->capture_default_str();
@@ -786,7 +788,9 @@ void add_bench_lines(CLI::App* bench) {
   auto la = std::make_shared<BenchLinesArgs>();
   lines->add_option("--brdf", la->brdf, "catalogue name or measured file")->capture_default_str();
   lines->add_option("--grid", la->grid, "regular res^4 parabolic grid")->capture_default_str();
-  lines->add_option("--sampling", la->sampling, "grid (--grid) or measured (a measured BRDF's own samples)")
+  lines->add_option("--sampling", la->sampling, "grid (--grid) or measured (a measured BRDF's own samples: the "
+                      "records alone, no orbit, weights or fill, as the thesis fitted "
+                      "them; `run` adds them)")
       ->check(CLI::IsMember({"grid", "measured"}))
       ->capture_default_str();
   lines->add_option("--texture", la->texture, "texture resolution of the objective")->capture_default_str();
