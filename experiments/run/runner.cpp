@@ -135,7 +135,12 @@ std::string validation_scheme(const Plan& plan, const BrdfVariant& b, const Samp
                          : std::string()));
   if (split)
     parts.push_back("held out: " + std::to_string(split->held.valid_count()) + " of " + std::to_string(all_valid) +
-                    " samples (" + format_number(plan.experiment.holdout * 100.0) + "%), not fitted");
+                    " samples (" + format_number(plan.experiment.holdout * 100.0) + "%" +
+                    (plan.experiment.folds == ExperimentSettings::kFoldsAuto
+                         ? "; folds = \"auto\": more than " +
+                               std::to_string(ExperimentSettings::kAutoFoldsMaxSamples) + " valid samples"
+                         : std::string()) +
+                    "), not fitted");
   if (folds)
     parts.push_back("held out: " + std::to_string(folds->folds) + "-fold (" +
                     (plan.experiment.folds == ExperimentSettings::kFoldsAuto

@@ -173,6 +173,18 @@ TEST_CASE("kfold: folds = auto holds out 5 folds of small raw sets and the singl
   CHECK(rb[0].at("validation").find("held out: 20 of 200 samples (10%)") != std::string::npos);
   CHECK(rb[0].at("samples") == "180");
   CHECK(ra[0].at("run_id") != rb[0].at("run_id"));
+  // Above the threshold "auto" holds out the single fraction and says why.
+  const std::string big = tmp / "big.csv";
+  write_sample_csv(sample_stratified(*bp, ExperimentSettings::kAutoFoldsMaxSamples + 1, 4), big);
+  std::string big_body = body;
+  big_body.replace(big_body.find(csv), csv.size(), big);
+  run_quiet(write_text(tmp / "c.toml", "[experiment]\n" + big_body), tmp / "c");
+  const auto rc = read_results_csv(tmp / "c/results.csv");
+  REQUIRE(rc.size() == 1);
+  INFO(rc[0].at("validation"));
+  CHECK(rc[0].at("validation").find("held out: 2000 of 20001 samples (10%; folds = \"auto\": more than 20000 valid "
+                                    "samples), not fitted") != std::string::npos);
+  CHECK(rc[0].at("samples") == "18001");
   CHECK(parse_plan("[experiment]\n" + body, tmp / "c.toml", {})
             .runs[0].identity["validation"]["folds"] == "auto");
   CHECK(!parse_plan(with(""), "cfg.toml", {}).runs[0].identity["validation"].contains("folds"));
