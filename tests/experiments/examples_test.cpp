@@ -14,7 +14,7 @@ const std::vector<std::string> kExamples = {
     "thesis-measured", "parameterizations", "baselines",          "bench-fit",
     "bench-search",    "bench-baselines", "refine",   "compare-storage",
     "sh-lighting",     "thesis-nongreedy", "thesis-bluepaint-mccool", "refine-blend", "thesis-retro", "thesis-ratio",
-    "cornell-validation", "shade-tolerance"};
+    "cornell-validation", "shade-tolerance", "cornell-baselines"};
 
 // Runs experiments/<name>.toml with the overrides; every run must succeed.
 void run_example(const std::string& name, const std::vector<std::string>& defines, size_t expected_runs) {
@@ -91,6 +91,11 @@ TEST_CASE("examples: cornell-validation at reduced size") {
               {"method.texture_size=6", "method.restarts=1", "method.terms=2", "brdf.model=[\"krylon-blue\"]",
                "sampling.symmetries=\"off\""},
               3);
+}
+
+TEST_CASE("examples: cornell-baselines at reduced size") {
+  run_example("cornell-baselines",
+              {"method.texture_size=6", "brdf.model=[\"krylon-blue\"]", "experiment.holdout=0.1"}, 4);
 }
 
 TEST_CASE("examples: parameterizations at reduced size") {
