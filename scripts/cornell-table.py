@@ -34,14 +34,19 @@ def key(r):
     return (r["brdf"], r["method"], r["parameterization"], r["terms"])
 
 
-def rows_of(folder):
+def run_rows(folder):
+    """The rows of folder/results.csv; exits naming the file when a run failed."""
     path = os.path.join(folder, "results.csv")
     with open(path, newline="") as f:
         rows = [r for r in csv.DictReader(f)]
     bad = [r["run_id"] for r in rows if r["status"] != "ok"]
     if bad:
         sys.exit(f"{path}: runs not ok: {', '.join(bad)}")
-    return {key(r): r for r in rows}
+    return rows
+
+
+def rows_of(folder):
+    return {key(r): r for r in run_rows(folder)}
 
 
 def before_rows():
@@ -64,12 +69,7 @@ def order(k):
 def print_baselines(raw, folder):
     """Per paint: McCool's raw fit, then each baseline (storage, held-out,
     whole-domain and image errors)."""
-    path = os.path.join(folder, "results.csv")
-    with open(path, newline="") as f:
-        base = [r for r in csv.DictReader(f)]
-    bad = [r["run_id"] for r in base if r["status"] != "ok"]
-    if bad:
-        sys.exit(f"{path}: runs not ok: {', '.join(bad)}")
+    base = run_rows(folder)
     print("| paint | method | storage_floats | holdout_rel_mse | val_rel_mse | shade_rmse | shade_rmse / McCool's |")
     print("|---|---|---|---|---|---|---|")
     for paint in PAINTS:
