@@ -63,13 +63,19 @@ double capped(Acc x) { return x < Acc(kBad) ? double(x) : kBad; }
 
 }  // namespace
 
-Metrics evaluate_metrics(const Brdf& approx, const SampleSet& s, const LogTransform& t) {
+namespace {
+
+// The metrics of samples [begin, end) of s, with fa(k) the approximation's
+// value at sample k (called once per valid sample).
+template <class Values>
+Metrics metrics_core(const SampleSet& s, size_t begin, size_t end, Values&& fa_of, const LogTransform& t) {
   Acc W = 0, rel_se = 0, rel_ae = 0, lin_se = 0, lin_ae = 0, cos_se = 0, rel_max = 0, lin_max = 0;
+  Acc rel_se_c[3] = {0, 0, 0};
   Metrics m;
-  for (size_t k = 0; k < s.size(); ++k) {
+  for (size_t k = begin; k < end; ++k) {
     if (!s.valid[k]) continue;
     const Acc w = s.weight_of(k);
-    const Rgb fa = approx.eval(s.wi[k], s.wo[k]);
+    const Rgb fa = fa_of(k);
     ++m.samples;
     W += 3 * w;
     for (int c = 0; c < 3; ++c) {
@@ -84,6 +90,7 @@ Metrics evaluate_metrics(const Brdf& approx, const SampleSet& s, const LogTransf
         dg = df = dc = kBad;
       }
       rel_se += w * dg * dg;
+      rel_se_c[c] += w * dg * dg;
       rel_ae += w * std::abs(dg);
       rel_max = std::max(rel_max, std::abs(dg));
       lin_se += w * df * df;
@@ -95,6 +102,7 @@ Metrics evaluate_metrics(const Brdf& approx, const SampleSet& s, const LogTransf
   if (m.samples == 0) throw std::invalid_argument("metrics: the sample set has no valid sample");
   if (!(W > 0)) throw std::invalid_argument("metrics: the sample weights sum to 0");
   m.rel_mse = capped(rel_se / W);
+  for (int c = 0; c < 3; ++c) m.rel_mse_channel[c] = capped(3 * rel_se_c[c] / W);
   m.rel_mae = capped(rel_ae / W);
   m.rel_max = capped(rel_max);
   m.lin_rmse = capped(std::sqrt(lin_se / W));
@@ -104,19 +112,20 @@ Metrics evaluate_metrics(const Brdf& approx, const SampleSet& s, const LogTransf
   return m;
 }
 
-double peak_ratio(const Brdf& approx, const SampleSet& s) {
+template <class Values>
+double peak_ratio_core(const SampleSet& s, size_t begin, size_t end, Values&& fa_of) {
   Rgb peak = Rgb::Zero();
   size_t n = 0;
-  for (size_t k = 0; k < s.size(); ++k)
+  for (size_t k = begin; k < end; ++k)
     if (s.valid[k]) {
       ++n;
       for (int c = 0; c < 3; ++c) peak[c] = std::max(peak[c], s.value[k][c]);
     }
   if (n == 0) throw std::invalid_argument("peak ratio: the sample set has no valid sample");
   double worst = 0.0;
-  for (size_t k = 0; k < s.size(); ++k) {
+  for (size_t k = begin; k < end; ++k) {
     if (!s.valid[k]) continue;
-    const Rgb fa = approx.eval(s.wi[k], s.wo[k]);
+    const Rgb fa = fa_of(k);
     for (int c = 0; c < 3; ++c) {
       if (!(peak[c] > 0.0)) continue;
       const double r = std::isfinite(fa[c]) ? std::max(fa[c], 0.0) / peak[c] : kBad;
@@ -124,6 +133,34 @@ double peak_ratio(const Brdf& approx, const SampleSet& s) {
     }
   }
   return std::min(worst, kBad);
+}
+
+void check_range(const SampleSet& s, size_t begin, size_t end, size_t values, const char* what) {
+  if (begin > end || end > s.size() || values != s.size())
+    throw std::invalid_argument(std::string(what) + ": expected 0 <= begin <= end <= " + std::to_string(s.size()) +
+                                " and one value per sample, found [" + std::to_string(begin) + ", " +
+                                std::to_string(end) + ") with " + std::to_string(values) + " values");
+}
+
+}  // namespace
+
+Metrics evaluate_metrics(const Brdf& approx, const SampleSet& s, const LogTransform& t) {
+  return metrics_core(s, 0, s.size(), [&](size_t k) { return approx.eval(s.wi[k], s.wo[k]); }, t);
+}
+
+double peak_ratio(const Brdf& approx, const SampleSet& s) {
+  return peak_ratio_core(s, 0, s.size(), [&](size_t k) { return approx.eval(s.wi[k], s.wo[k]); });
+}
+
+Metrics metrics_of_values(const SampleSet& s, size_t begin, size_t end, const std::vector<Rgb>& values,
+                          const LogTransform& t) {
+  check_range(s, begin, end, values.size(), "metrics of values");
+  return metrics_core(s, begin, end, [&](size_t k) { return values[k]; }, t);
+}
+
+double peak_ratio_of_values(const SampleSet& s, size_t begin, size_t end, const std::vector<Rgb>& values) {
+  check_range(s, begin, end, values.size(), "peak ratio of values");
+  return peak_ratio_core(s, begin, end, [&](size_t k) { return values[k]; });
 }
 
 double metric_value(const Metrics& m, const std::string& name) {

@@ -2,7 +2,9 @@
 // same samples, so numbers in one table are comparable.
 #pragma once
 
+#include <array>
 #include <string>
+#include <vector>
 
 #include "brdfs/brdf.h"
 #include "brdfs/sampleset.h"
@@ -24,6 +26,7 @@ struct Metrics {
   double rel_mse = 0, rel_mae = 0, rel_max = 0;    // on g (log space)
   double lin_rmse = 0, lin_mae = 0, lin_max = 0;   // on f (1/sr)
   double cos_rmse = 0;                              // on (f_approx - f) cos(theta_i)
+  std::array<double, 3> rel_mse_channel{0, 0, 0};   // rel_mse of R, G, B alone (their mean is rel_mse)
   size_t samples = 0;                               // valid samples scored
 };
 
@@ -44,6 +47,17 @@ Metrics evaluate_metrics(const Brdf& approx, const SampleSet& s, const LogTransf
 // 1e300 and the result is capped at 1e300. 1 or less: the approximation never
 // exceeds what the BRDF reaches on this set. Throws if s has no valid sample.
 double peak_ratio(const Brdf& approx, const SampleSet& s);
+
+// The same two on samples [begin, end) of s only, with the approximation's
+// values given: values[k] for sample k (values has one entry per sample of s;
+// entries outside the range or at masked samples are not read). The
+// validation set scores prefixes of one set this way, evaluating the
+// approximation once (experiments/report/validation.h). Throws
+// std::invalid_argument for a range outside s or a values vector of another
+// size, and as above.
+Metrics metrics_of_values(const SampleSet& s, size_t begin, size_t end, const std::vector<Rgb>& values,
+                          const LogTransform& t);
+double peak_ratio_of_values(const SampleSet& s, size_t begin, size_t end, const std::vector<Rgb>& values);
 
 // The metric named `name` ("rel_mse", ..., "cos_rmse"); throws for unknown names.
 double metric_value(const Metrics& m, const std::string& name);

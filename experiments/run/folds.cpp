@@ -69,22 +69,8 @@ FoldSummary summarize_folds(const std::vector<Metrics>& per_fold) {
 }
 
 std::array<double, 3> channel_rel_mse(const Brdf& approx, const SampleSet& s, const LogTransform& lt) {
-  long double sum[3] = {0, 0, 0}, wsum = 0;
-  for (size_t k = 0; k < s.size(); ++k) {
-    if (!s.valid[k]) continue;
-    const double w = s.weight_of(k);
-    const Rgb a = approx.eval(s.wi[k], s.wo[k]);
-    for (int c = 0; c < 3; ++c) {
-      double d = std::isfinite(a[c]) ? lt.g(c, a[c]) - lt.g(c, s.value[k][c]) : 1e150;
-      if (!std::isfinite(d)) d = 1e150;  // as evaluate_metrics: an error of 1e300
-      sum[c] += static_cast<long double>(w) * d * d;
-    }
-    wsum += w;
-  }
-  std::array<double, 3> out{0, 0, 0};
-  if (wsum > 0)
-    for (int c = 0; c < 3; ++c) out[c] = std::min(1e300, static_cast<double>(sum[c] / wsum));
-  return out;
+  if (s.valid_count() == 0) return {0, 0, 0};
+  return evaluate_metrics(approx, s, lt).rel_mse_channel;
 }
 
 std::string FoldSummary::spread() const {
