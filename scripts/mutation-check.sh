@@ -64,6 +64,8 @@ sample=(
   't2-share-of-b|search/structure.cpp|s/best\.share_a = a \/ all;/best.share_a = b \/ all;/|test_search|structure:*'
   't3-hessian-diagonal-halved|search/structure.cpp|s/if \(i == j\) H\(i, i\) = 2 \* v;/if (i == j) H(i, i) = v;/|test_search|structure:*'
   't4-total-of-norms|search/structure.cpp|s/all \+= H\.squaredNorm\(\);/all += H.norm();/|test_search|structure:*'
+  'va1-auto-never-doubles|experiments/report/validation.cpp|s/    blocks = std::min\(2 \* blocks, d\.blocks\);/    break;/|test_experiments|validation auto:*'
+  'va2-se-without-sqrt-n|experiments/report/validation.cpp|s/sd \/ std::sqrt\(static_cast<long double>\(n\)\) \/ mean/sd \/ mean/|test_experiments|validation auto:*'
   'r1-csv-theta-to-2pi|brdfs/sample_csv.cpp|s/hi = theta \? M_PI :/hi = theta ? 2.0 * M_PI :/|test_brdfs|~[slow]'
   'r2-csv-weight-dropped|brdfs/sample_csv.cpp|s/has_weight \? v\[7\] : 1\.0\);/1.0);/|test_brdfs|~[slow]'
   'r3-reader-negative-theta|brdfs/measured_readers.cpp|s/if \(!\(v >= 0\.0 && v <= M_PI \/ 2 \+ kTol\)\)/if (!(v <= M_PI \/ 2 + kTol))/|test_brdfs|~[slow]'

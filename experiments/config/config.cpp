@@ -100,7 +100,14 @@ ExperimentSettings read_experiment(const toml::table* t, Ctx& ctx, const std::st
   e.render = r.boolean("render", true);
   e.export_factors = r.boolean("export", true);
   e.metric_eps = r.number("metric_eps", 1e-5, 0.0, 1.0, true);
-  e.validation_pairs = static_cast<int>(r.integer("validation_pairs", e.validation_pairs, 0, 1000000));
+  // Default "auto": blocks scored until the val_rel_mse is precise
+  // (experiments/report/validation.h); a number: one set of that many pairs.
+  if (r.has("validation_pairs") && r.combo().at("validation_pairs")->is_string()) {
+    r.choice("validation_pairs", "auto", {"auto"});
+    e.validation_pairs = ExperimentSettings::kValidationAuto;
+  } else {
+    e.validation_pairs = static_cast<int>(r.integer("validation_pairs", e.validation_pairs, 0, 1000000));
+  }
   e.holdout = r.number("holdout", e.holdout, 0.0, 0.5, false);
   // Default: auto (5 folds on small raw sample sets), unless the single
   // fraction is chosen by setting `holdout`.
@@ -582,7 +589,9 @@ static json identity_common(const Plan& plan) {
                  {"render", plan.experiment.render},
                  {"export", plan.experiment.export_factors},
                  {"scene", plan.scene.identity()},
-                 {"validation", {{"pairs", plan.experiment.validation_pairs},
+                 {"validation", {{"pairs", plan.experiment.validation_pairs == ExperimentSettings::kValidationAuto
+                                               ? json("auto")
+                                               : json(plan.experiment.validation_pairs)},
                                  {"holdout", plan.experiment.holdout},
                                  {"seed", validation_seed(plan.experiment.seed)}}}};
   // Only when on: runs without folds keep their ids. "auto" enters only the

@@ -47,9 +47,18 @@ struct ExperimentSettings {
   bool export_factors = true;  // per run: factor textures, sidecar, GLSL (config key `export`)
   double metric_eps = 1e-5; // eps of the log transform every method is scored with (docs/design.md §4)
   // Validation (docs/design.md §4 "validation"): stratified pairs over the
-  // whole hemisphere pair scored against the BRDF (0 = none), and the
-  // fraction of measured/file samples held out of the fit.
-  int validation_pairs = 4096;
+  // whole hemisphere pair scored against the BRDF (0 = none; kValidationAuto,
+  // the default: blocks of kValidationBlockPairs, from kValidationMinBlocks
+  // doubled until the standard error of val_rel_mse is at most
+  // kValidationTargetSe of it or kValidationMaxBlocks are scored;
+  // experiments/report/validation.h), and the fraction of measured/file
+  // samples held out of the fit.
+  int validation_pairs = kValidationAuto;
+  static constexpr int kValidationAuto = -1;
+  static constexpr int kValidationBlockPairs = 4096;
+  static constexpr int kValidationMinBlocks = 8;
+  static constexpr int kValidationMaxBlocks = 64;
+  static constexpr double kValidationTargetSe = 0.015;
   double holdout = 0.1;
   // k-fold hold-out instead of the single fraction (experiments/run/folds.h):
   // 0 = off; k >= 2 fits each method k times without one fold each, and the

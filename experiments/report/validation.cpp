@@ -1,7 +1,9 @@
 // Validation sets, held-out samples and flags (see validation.h).
 #include "experiments/report/validation.h"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 #include "experiments/common/splitmix.h"
@@ -72,13 +74,112 @@ SampleSet validation_set(const Brdf& brdf, int pairs, uint64_t seed) {
   return v;
 }
 
-ValidationScores score_validation(const Brdf& approx, const SampleSet* domain, const SampleSet* held,
+uint64_t validation_block_seed(uint64_t seed, int block) {
+  if (block == 0) return seed;
+  uint64_t x = seed ^ (0x9E3779B97F4A7C15ull * static_cast<uint64_t>(block));
+  return splitmix(x);
+}
+
+DomainSet domain_set(const Brdf& brdf, int validation_pairs, uint64_t seed) {
+  DomainSet d;
+  d.seed = seed;
+  if (validation_pairs != ExperimentSettings::kValidationAuto) {
+    if (validation_pairs < 1)
+      throw std::invalid_argument("validation_pairs: expected \"auto\" or a number of pairs >= 1, found " +
+                                  std::to_string(validation_pairs));
+    d.pairs = validation_set(brdf, validation_pairs, seed);
+    return d;
+  }
+  d.block_pairs = ExperimentSettings::kValidationBlockPairs;
+  d.blocks = ExperimentSettings::kValidationMaxBlocks;
+  size_t skipped = 0;
+  for (int b = 0; b < d.blocks; ++b) {
+    SampleSet block = validation_set(brdf, d.block_pairs, validation_block_seed(seed, b));
+    skipped += block.size() - block.valid_count();
+    for (size_t k = 0; k < block.size(); ++k) {
+      d.pairs.wi.push_back(block.wi[k]);
+      d.pairs.wo.push_back(block.wo[k]);
+      d.pairs.value.push_back(block.value[k]);
+      d.pairs.valid.push_back(block.valid[k]);
+    }
+  }
+  d.pairs.description = "validation: " + std::to_string(d.blocks) + " stratified blocks of " +
+                        std::to_string(d.block_pairs) + " pairs over the hemisphere pair" +
+                        (skipped > 0 ? " (" + std::to_string(skipped) + " where the truth has no data skipped)"
+                                     : std::string());
+  return d;
+}
+
+double relative_standard_error(const std::vector<double>& block_rel_mse) {
+  const size_t n = block_rel_mse.size();
+  if (n < 2) return std::numeric_limits<double>::infinity();
+  long double mean = 0;
+  for (double e : block_rel_mse) mean += e;
+  mean /= static_cast<long double>(n);
+  if (!(mean > 0)) return 0.0;
+  long double ss = 0;
+  for (double e : block_rel_mse) ss += (e - mean) * (e - mean);
+  const long double sd = std::sqrt(ss / static_cast<long double>(n - 1));
+  return static_cast<double>(sd / std::sqrt(static_cast<long double>(n)) / mean);
+}
+
+SampleSet first_samples(const SampleSet& s, size_t n) {
+  if (n >= s.size()) return s;
+  SampleSet p;
+  p.wi.assign(s.wi.begin(), s.wi.begin() + n);
+  p.wo.assign(s.wo.begin(), s.wo.begin() + n);
+  p.value.assign(s.value.begin(), s.value.begin() + n);
+  p.valid.assign(s.valid.begin(), s.valid.begin() + n);
+  if (!s.weight.empty()) p.weight.assign(s.weight.begin(), s.weight.begin() + n);
+  p.description = "the first " + std::to_string(n) + " pairs of " + s.description;
+  p.symmetries = s.symmetries;
+  return p;
+}
+
+namespace {
+
+// An "auto" domain: whole blocks, kValidationMinBlocks first, doubled while
+// the val rel_mse is less precise than kValidationTargetSe.
+void score_blocks(const Brdf& approx, const DomainSet& d, const LogTransform& lt, ValidationScores& v) {
+  const SampleSet& s = d.pairs;
+  const size_t bp = static_cast<size_t>(d.block_pairs);
+  std::vector<Rgb> values(s.size(), Rgb::Zero());
+  std::vector<double> block_err;
+  int blocks = std::min(ExperimentSettings::kValidationMinBlocks, d.blocks);
+  int done = 0;
+  while (true) {
+    for (; done < blocks; ++done) {
+      const size_t b0 = static_cast<size_t>(done) * bp, b1 = b0 + bp;
+      size_t valid = 0;
+      for (size_t k = b0; k < b1; ++k)
+        if (s.valid[k]) values[k] = approx.eval(s.wi[k], s.wo[k]), ++valid;
+      if (valid > 0) block_err.push_back(metrics_of_values(s, b0, b1, values, lt).rel_mse);
+    }
+    v.rel_se = relative_standard_error(block_err);
+    if (v.rel_se <= ExperimentSettings::kValidationTargetSe || blocks >= d.blocks) break;
+    blocks = std::min(2 * blocks, d.blocks);
+  }
+  const size_t end = static_cast<size_t>(blocks) * bp;
+  v.blocks = blocks;
+  v.pairs = end;
+  v.val = metrics_of_values(s, 0, end, values, lt);
+  v.max_ratio = peak_ratio_of_values(s, 0, end, values);
+}
+
+}  // namespace
+
+ValidationScores score_validation(const Brdf& approx, const DomainSet* domain, const SampleSet* held,
                                   const LogTransform& lt) {
   ValidationScores v;
-  if (domain && domain->valid_count() > 0) {
+  if (domain && domain->pairs.valid_count() > 0) {
     v.domain = true;
-    v.val = evaluate_metrics(approx, *domain, lt);
-    v.max_ratio = peak_ratio(approx, *domain);
+    if (domain->block_pairs > 0) {
+      score_blocks(approx, *domain, lt, v);
+    } else {
+      v.val = evaluate_metrics(approx, domain->pairs, lt);
+      v.max_ratio = peak_ratio(approx, domain->pairs);
+      v.pairs = domain->pairs.size();
+    }
   }
   if (held && held->valid_count() > 0) {
     v.holdout = true;

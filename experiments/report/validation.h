@@ -57,19 +57,48 @@ HoldoutSplit split_holdout(const SampleSet& s, double fraction, uint64_t seed);
 // cells) are masked, and the description counts them: the whole-domain
 // columns compare only where the truth holds.
 SampleSet validation_set(const Brdf& brdf, int pairs, uint64_t seed);
-
+// The seed of block b of the "auto" set: seed itself for block 0 (so block 0
+// is validation_set(brdf, kValidationBlockPairs, seed)), a SplitMix64 draw of
+// (seed, b) for the others.
+uint64_t validation_block_seed(uint64_t seed, int block);
+// A run's whole-domain set. With experiment.validation_pairs = N: one
+// stratified set of N pairs, scored whole (block_pairs = 0). With "auto"
+// (the default): `blocks` independent stratified blocks of block_pairs pairs
+// each (block b drawn with validation_block_seed(seed, b)), one after the
+// other in `pairs`; score_validation scores a prefix of whole blocks, as
+// many as its precision rule needs.
+struct DomainSet {
+  SampleSet pairs;
+  int block_pairs = 0;
+  int blocks = 1;
+  uint64_t seed = 0;
+};
+// Throws std::invalid_argument for pairs < 1 (other than kValidationAuto).
+DomainSet domain_set(const Brdf& brdf, int validation_pairs, uint64_t seed);
+// The "auto" rule's precision: the standard error of the rel_mse over b equal
+// blocks, sd(block rel_mse) / sqrt(b), relative to their mean (0 when the mean
+// is 0; the blocks are independent stratified sets, so their errors are
+// independent draws). blocks with fewer than 2 entries give +infinity.
+double relative_standard_error(const std::vector<double>& block_rel_mse);
 // Scores of one approximation on the validation data.
 struct ValidationScores {
-  bool domain = false;   // a whole-domain set was scored
-  Metrics val;           // on the whole-domain set (with the fit's log transform)
-  double max_ratio = 0;  // peak_ratio on the whole-domain set
-  bool holdout = false;  // held-out samples were scored
-  Metrics held;          // on the held-out samples
+  bool domain = false;    // a whole-domain set was scored
+  Metrics val;            // on the whole-domain set (with the fit's log transform)
+  double max_ratio = 0;   // peak_ratio on the whole-domain set
+  size_t pairs = 0;       // pairs of the domain set scored (a prefix of it with "auto")
+  int blocks = 0;         // "auto": blocks scored; 0 for a set scored whole
+  double rel_se = -1;     // "auto": relative_standard_error of val rel_mse; -1 otherwise
+  bool holdout = false;   // held-out samples were scored
+  Metrics held;           // on the held-out samples
 };
-// domain / held may be null (not scored).
-ValidationScores score_validation(const Brdf& approx, const SampleSet* domain, const SampleSet* held,
+// domain / held may be null (not scored). With an "auto" domain: blocks
+// kValidationMinBlocks, then doubled (up to the domain's blocks) while the
+// relative standard error of val rel_mse is above kValidationTargetSe; the
+// approximation is evaluated once per pair scored.
+ValidationScores score_validation(const Brdf& approx, const DomainSet* domain, const SampleSet* held,
                                   const LogTransform& lt);
-
+// The first n pairs of a set (the scored prefix of an "auto" domain).
+SampleSet first_samples(const SampleSet& s, size_t n);
 // Fills val_rel_mse, val_cos_rmse, val_max_ratio, holdout_rel_mse,
 // holdout_cos_rmse and `validation` (the scheme in words) from the scores;
 // appends to `notes` a "flag: ..." entry per threshold crossed (and sets

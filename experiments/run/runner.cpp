@@ -105,34 +105,42 @@ class RenderCache {
     return slot;
   }
   // nullptr when experiment.validation_pairs = 0.
-  std::shared_ptr<const SampleSet> validation(const Plan& plan, size_t brdf) {
-    if (plan.experiment.validation_pairs <= 0) return nullptr;
+  std::shared_ptr<const DomainSet> validation(const Plan& plan, size_t brdf) {
+    if (plan.experiment.validation_pairs == 0) return nullptr;
     std::unique_lock<std::mutex> lk(mu_);
     auto& slot = sets_[brdf];
     if (!slot)
-      slot = std::make_shared<SampleSet>(validation_set(*plan.brdfs[brdf].brdf, plan.experiment.validation_pairs,
-                                                        validation_seed(plan.experiment.seed)));
+      slot = std::make_shared<DomainSet>(domain_set(*plan.brdfs[brdf].brdf, plan.experiment.validation_pairs,
+                                                    validation_seed(plan.experiment.seed)));
     return slot;
   }
 
  private:
   std::mutex mu_;
   std::map<size_t, std::shared_ptr<const SphereRender>> map_;
-  std::map<size_t, std::shared_ptr<const SampleSet>> sets_;
+  std::map<size_t, std::shared_ptr<const DomainSet>> sets_;
 };
 
 // The validation scheme of a run, in words (the `validation` column).
-std::string validation_scheme(const Plan& plan, const BrdfVariant& b, const SampleSet* domain,
-                              const HoldoutSplit* split, const FoldSummary* folds, size_t all_valid) {
+std::string validation_scheme(const Plan& plan, const BrdfVariant& b, const DomainSet* domain,
+                              const ValidationScores& vs, const HoldoutSplit* split, const FoldSummary* folds,
+                              size_t all_valid) {
   std::vector<std::string> parts;
-  if (domain)
-    parts.push_back("domain: " + std::to_string(domain->size()) + " stratified pairs (seed " +
-                    std::to_string(validation_seed(plan.experiment.seed)) + ") vs the " +
-                    (b.measured ? "interpolant" : "BRDF") +
-                    (domain->valid_count() < domain->size()
-                         ? " (" + std::to_string(domain->size() - domain->valid_count()) +
-                               " where it has no data skipped)"
+  if (domain) {
+    size_t no_data = 0;
+    for (size_t k = 0; k < vs.pairs; ++k) no_data += domain->pairs.valid[k] ? 0 : 1;
+    const std::string seed = "seed " + std::to_string(validation_seed(plan.experiment.seed));
+    std::string how = std::to_string(vs.pairs) + " stratified pairs (" + seed + ")";
+    if (domain->block_pairs > 0)
+      how = std::to_string(vs.pairs) + " stratified pairs in " + std::to_string(vs.blocks) + " blocks of " +
+            std::to_string(domain->block_pairs) + " (validation_pairs = \"auto\": standard error of val_rel_mse " +
+            format_short(format_number(100.0 * vs.rel_se)) + "%, target " +
+            format_number(100.0 * ExperimentSettings::kValidationTargetSe) + "% or " +
+            std::to_string(domain->blocks * domain->block_pairs) + " pairs; " + seed + ")";
+    parts.push_back("domain: " + how + " vs the " + (b.measured ? "interpolant" : "BRDF") +
+                    (no_data > 0 ? " (" + std::to_string(no_data) + " where it has no data skipped)"
                          : std::string()));
+  }
   if (split)
     parts.push_back("held out: " + std::to_string(split->held.valid_count()) + " of " + std::to_string(all_valid) +
                     " samples (" + format_number(plan.experiment.holdout * 100.0) + "%" +
@@ -158,7 +166,7 @@ std::string validation_scheme(const Plan& plan, const BrdfVariant& b, const Samp
 // val_*: factor/size_choice.h), the method's copy with the scorer set: every
 // kind's selection then judges candidates by the scene or the validation set.
 MethodVariant with_tolerance_scorer(const MethodVariant& m, const Plan& plan, const PlannedRun& pr,
-                                    RenderCache& renders, std::shared_ptr<const SampleSet> domain,
+                                    RenderCache& renders, std::shared_ptr<const DomainSet> domain,
                                     const LogTransform& lt) {
   MethodVariant mv = m;
   if (!mv.tolerance || !is_external_metric(mv.tolerance->metric)) return mv;
@@ -172,7 +180,7 @@ MethodVariant with_tolerance_scorer(const MethodVariant& m, const Plan& plan, co
   } else {
     if (!domain)
       throw std::runtime_error("tolerance " + metric +
-                               " needs a whole-domain validation set: validation_pairs > 0 and a BRDF that is a "
+                               " needs a whole-domain validation set: validation_pairs \"auto\" or > 0 and a BRDF that is a "
                                "truth over the whole domain (an interpolant whose samples declare "
                                "isotropic+reciprocal+bilateral; docs/design.md §4.3)");
     mv.tolerance->score = [domain, lt, metric](const Brdf& cand) {
@@ -257,14 +265,19 @@ HeldOutData held_out_data(const Plan& plan, const PlannedRun& pr, const SampleSe
   return d;
 }
 
-// run.json validation entries beyond the scheme: the per-channel rel_mse
-// (R, G, B) of the run's fit on the whole-domain set and the held-out
-// samples, and each fold's scores.
-void record_held_out(json& v, const ValidationScores& vs, const Brdf& result, const SampleSet* domain,
-                     const HoldoutSplit* split, const LogTransform& lt, const HeldOutStage& held) {
+// run.json validation entries beyond the scheme: the pairs scored (with
+// "auto" also the blocks and the relative standard error of val_rel_mse),
+// the per-channel rel_mse (R, G, B) of the run's fit on the whole-domain set
+// and the held-out samples, and each fold's scores.
+void record_held_out(json& v, const ValidationScores& vs, const DomainSet* domain, const HoldoutSplit* split,
+                     const HeldOutStage& held) {
   json per_channel = json::object();
-  if (vs.domain && domain) per_channel["val"] = channel_rel_mse(result, *domain, lt);
-  if (split && vs.holdout) per_channel["holdout"] = channel_rel_mse(result, split->held, lt);
+  if (vs.domain && domain) {
+    v["pairs"] = vs.pairs;
+    if (domain->block_pairs > 0) v["blocks"] = vs.blocks, v["val_rel_mse_standard_error"] = vs.rel_se;
+    per_channel["val"] = vs.val.rel_mse_channel;
+  }
+  if (split && vs.holdout) per_channel["holdout"] = vs.held.rel_mse_channel;
   if (!per_channel.empty()) v["channel_rel_mse"] = per_channel;
   if (held.folds) {
     v["folds"] = held.folds_record;
@@ -463,13 +476,13 @@ RunEntry execute_run(const Plan& plan, const PlannedRun& pr, const SampleSet& sa
     const auto tv = Clock::now();
     ValidationScores vs = score_validation(*out.result, domain.get(), split ? &split->held : nullptr, lt);
     if (fold_summary) vs.holdout = true, vs.held = fold_summary->mean();
-    std::string scheme = validation_scheme(plan, b, domain.get(), split ? &*split : nullptr,
+    std::string scheme = validation_scheme(plan, b, domain.get(), vs, split ? &*split : nullptr,
                                            fold_summary ? &*fold_summary : nullptr, samples.valid_count());
-    if (!domain && plan.experiment.validation_pairs > 0)
+    if (!domain && plan.experiment.validation_pairs != 0)
       scheme = "no whole-domain columns: " + why_no_domain + (scheme.empty() ? "" : "; " + scheme);
     fill_validation_columns(vs, mt.rel_mse, scheme, row, notes);
     rec["validation"] = {{"scheme", scheme}, {"seconds", since(tv)}};
-    record_held_out(rec["validation"], vs, *out.result, domain.get(), split ? &*split : nullptr, lt, held);
+    record_held_out(rec["validation"], vs, domain.get(), split ? &*split : nullptr, held);
   }
 
   if (plan.experiment.export_factors) kind.export_files(c, out);

@@ -95,7 +95,9 @@ TEST_CASE("fill: the training interpolant's pairs carry exactly the share of the
   const FillChoice g = choose_fill(measured_sampling(-1.0), truth.get(), kOrbit, fill_seed(3));
   const SampleSet pairs = with_fill(fit, g);
   REQUIRE(pairs.size() == 50 + kFillPairs);
-  const SampleSet val = validation_set(*truth, 1024, validation_seed(3));
+  // The default ("auto") set: every block that a run may score.
+  const SampleSet val = domain_set(*truth, ExperimentSettings::kValidationAuto, validation_seed(3)).pairs;
+  REQUIRE(val.size() == size_t(ExperimentSettings::kValidationMaxBlocks) * ExperimentSettings::kValidationBlockPairs);
   std::set<std::pair<double, double>> seen;
   for (size_t k = 0; k < val.size(); ++k) seen.insert({val.wi[k].x(), val.wo[k].y()});
   size_t shared = 0;
@@ -103,7 +105,7 @@ TEST_CASE("fill: the training interpolant's pairs carry exactly the share of the
   CHECK(shared == 0);
   // A fill drawn like the validation set (its count and seed) is seen as a leak.
   FillChoice same = g;
-  same.pairs = 1024;
+  same.pairs = ExperimentSettings::kValidationBlockPairs;  // block 0's count and seed
   same.seed = validation_seed(3);
   const SampleSet leak = with_fill(fit, same);
   size_t leaked = 0;
