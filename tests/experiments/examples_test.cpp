@@ -14,7 +14,7 @@ const std::vector<std::string> kExamples = {
     "thesis-measured", "parameterizations", "baselines",          "bench-fit",
     "bench-search",    "bench-baselines", "refine",   "compare-storage",
     "sh-lighting",     "thesis-nongreedy", "thesis-bluepaint-mccool", "refine-blend", "thesis-retro", "thesis-ratio",
-    "cornell-validation", "shade-tolerance", "cornell-baselines"};
+    "cornell-validation", "shade-tolerance", "cornell-baselines", "validation-convergence"};
 
 // Runs experiments/<name>.toml with the overrides; every run must succeed.
 void run_example(const std::string& name, const std::vector<std::string>& defines, size_t expected_runs) {
@@ -69,6 +69,11 @@ TEST_CASE("examples: thesis-cook-torrance at reduced size") {
               {"sampling.resolution=6", "method.texture_size=6", "method.search_texture_size=0",
                "method.restarts=1", "method.terms=2", "scene.size=24"},
               5);
+}
+
+TEST_CASE("examples: validation-convergence at reduced size") {
+  run_example("validation-convergence",
+              {"sampling.resolution=6", "method.texture_size=6", "method.restarts=1"}, 2);
 }
 
 TEST_CASE("examples: thesis-setup at reduced size") {
