@@ -126,7 +126,10 @@ std::string validation_scheme(const Plan& plan, const BrdfVariant& b, const Doma
                               const ValidationScores& vs, const HoldoutSplit* split, const FoldSummary* folds,
                               size_t all_valid) {
   std::vector<std::string> parts;
-  if (domain) {
+  if (domain && !vs.domain) {
+    parts.push_back("domain: no pair of the set where the " + std::string(b.measured ? "interpolant" : "BRDF") +
+                    " has data");
+  } else if (domain) {
     size_t no_data = 0;
     for (size_t k = 0; k < vs.pairs; ++k) no_data += domain->pairs.valid[k] ? 0 : 1;
     const std::string seed = "seed " + std::to_string(validation_seed(plan.experiment.seed));
