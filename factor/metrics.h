@@ -26,7 +26,9 @@ struct Metrics {
   double rel_mse = 0, rel_mae = 0, rel_max = 0;    // on g (log space)
   double lin_rmse = 0, lin_mae = 0, lin_max = 0;   // on f (1/sr)
   double cos_rmse = 0;                              // on (f_approx - f) cos(theta_i)
-  std::array<double, 3> rel_mse_channel{0, 0, 0};   // rel_mse of R, G, B alone (their mean is rel_mse)
+  // rel_mse of R, G, B alone: sum_k w_k (g_c(f_approx) - g_c(f))^2 / sum_k w_k
+  // (their mean is rel_mse); run.json `validation.channel_rel_mse`.
+  std::array<double, 3> rel_mse_channel{0, 0, 0};
   size_t samples = 0;                               // valid samples scored
 };
 

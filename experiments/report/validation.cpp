@@ -82,7 +82,6 @@ uint64_t validation_block_seed(uint64_t seed, int block) {
 
 DomainSet domain_set(const Brdf& brdf, int validation_pairs, uint64_t seed) {
   DomainSet d;
-  d.seed = seed;
   if (validation_pairs != ExperimentSettings::kValidationAuto) {
     if (validation_pairs < 1)
       throw std::invalid_argument("validation_pairs: expected \"auto\" or a number of pairs >= 1, found " +
@@ -121,19 +120,6 @@ double relative_standard_error(const std::vector<double>& block_rel_mse) {
   for (double e : block_rel_mse) ss += (e - mean) * (e - mean);
   const long double sd = std::sqrt(ss / static_cast<long double>(n - 1));
   return static_cast<double>(sd / std::sqrt(static_cast<long double>(n)) / mean);
-}
-
-SampleSet first_samples(const SampleSet& s, size_t n) {
-  if (n >= s.size()) return s;
-  SampleSet p;
-  p.wi.assign(s.wi.begin(), s.wi.begin() + n);
-  p.wo.assign(s.wo.begin(), s.wo.begin() + n);
-  p.value.assign(s.value.begin(), s.value.begin() + n);
-  p.valid.assign(s.valid.begin(), s.valid.begin() + n);
-  if (!s.weight.empty()) p.weight.assign(s.weight.begin(), s.weight.begin() + n);
-  p.description = "the first " + std::to_string(n) + " pairs of " + s.description;
-  p.symmetries = s.symmetries;
-  return p;
 }
 
 namespace {

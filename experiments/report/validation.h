@@ -71,7 +71,6 @@ struct DomainSet {
   SampleSet pairs;
   int block_pairs = 0;
   int blocks = 1;
-  uint64_t seed = 0;
 };
 // Throws std::invalid_argument for pairs < 1 (other than kValidationAuto).
 DomainSet domain_set(const Brdf& brdf, int validation_pairs, uint64_t seed);
@@ -97,8 +96,6 @@ struct ValidationScores {
 // approximation is evaluated once per pair scored.
 ValidationScores score_validation(const Brdf& approx, const DomainSet* domain, const SampleSet* held,
                                   const LogTransform& lt);
-// The first n pairs of a set (the scored prefix of an "auto" domain).
-SampleSet first_samples(const SampleSet& s, size_t n);
 // Fills val_rel_mse, val_cos_rmse, val_max_ratio, holdout_rel_mse,
 // holdout_cos_rmse and `validation` (the scheme in words) from the scores;
 // appends to `notes` a "flag: ..." entry per threshold crossed (and sets

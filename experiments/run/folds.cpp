@@ -68,11 +68,6 @@ FoldSummary summarize_folds(const std::vector<Metrics>& per_fold) {
   return s;
 }
 
-std::array<double, 3> channel_rel_mse(const Brdf& approx, const SampleSet& s, const LogTransform& lt) {
-  if (s.valid_count() == 0) return {0, 0, 0};
-  return evaluate_metrics(approx, s, lt).rel_mse_channel;
-}
-
 std::string FoldSummary::spread() const {
   return "rel_mse sd " + format_short(format_number(rel_mse_sd)) + ", range " +
          format_short(format_number(rel_mse_min)) + "-" + format_short(format_number(rel_mse_max)) + " over " +

@@ -5,7 +5,6 @@
 // scored, rendered and exported, uses every sample.
 #pragma once
 
-#include <array>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -44,10 +43,5 @@ struct FoldSummary {
 };
 FoldSummary summarize_folds(const std::vector<Metrics>& per_fold);
 
-// rel_mse of factor/metrics.h per channel (R, G, B): the weighted mean over
-// the valid samples of s of (g_c(approx) - g_c(f))^2, with lt's transform
-// (non-finite values count as an error of 1e300, capped at 1e300). run.json
-// `validation.channel_rel_mse` (docs/results.md "zero channels").
-std::array<double, 3> channel_rel_mse(const Brdf& approx, const SampleSet& s, const LogTransform& lt);
 
 }  // namespace bf

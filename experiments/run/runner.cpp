@@ -130,8 +130,7 @@ std::string validation_scheme(const Plan& plan, const BrdfVariant& b, const Doma
     parts.push_back("domain: no pair of the set where the " + std::string(b.measured ? "interpolant" : "BRDF") +
                     " has data");
   } else if (domain) {
-    size_t no_data = 0;
-    for (size_t k = 0; k < vs.pairs; ++k) no_data += domain->pairs.valid[k] ? 0 : 1;
+    const size_t no_data = vs.pairs - vs.val.samples;  // masked pairs of the prefix scored
     const std::string seed = "seed " + std::to_string(validation_seed(plan.experiment.seed));
     std::string how = std::to_string(vs.pairs) + " stratified pairs (" + seed + ")";
     if (domain->block_pairs > 0)

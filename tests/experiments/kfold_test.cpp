@@ -255,7 +255,7 @@ TEST_CASE("kfold: per-channel rel_mse averages to rel_mse and isolates the chann
   };
   const GreenTwice g(bp);
   const LogTransform lt = LogTransform::of(s);
-  const auto ch = channel_rel_mse(g, s, lt);
+  const auto ch = evaluate_metrics(g, s, lt).rel_mse_channel;
   CHECK(ch[0] == Approx(0.0).margin(1e-20));
   CHECK(ch[2] == Approx(0.0).margin(1e-20));
   CHECK(ch[1] > 0.1);

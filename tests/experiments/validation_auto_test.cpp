@@ -20,6 +20,20 @@ namespace {
 
 constexpr int kBlock = ExperimentSettings::kValidationBlockPairs;
 
+// The first n pairs of a set (the prefix an "auto" domain scored).
+SampleSet first_samples(const SampleSet& s, size_t n) {
+  if (n >= s.size()) return s;
+  SampleSet p;
+  p.wi.assign(s.wi.begin(), s.wi.begin() + n);
+  p.wo.assign(s.wo.begin(), s.wo.begin() + n);
+  p.value.assign(s.value.begin(), s.value.begin() + n);
+  p.valid.assign(s.valid.begin(), s.valid.begin() + n);
+  if (!s.weight.empty()) p.weight.assign(s.weight.begin(), s.weight.begin() + n);
+  p.description = "the first " + std::to_string(n) + " pairs of " + s.description;
+  p.symmetries = s.symmetries;
+  return p;
+}
+
 // The wrapped BRDF, times `gain` where wo is within `radius` (radians) of the
 // mirror direction of wi and wi is beyond 60 degrees from the normal: an
 // approximation wrong only on a small off-axis region, whose error the
