@@ -8,6 +8,7 @@
 #include <random>
 #include <stdexcept>
 #include <limits>
+#include <string>
 #include <unordered_map>
 
 #include "search/powell.h"
@@ -19,19 +20,34 @@ double structure_radius(size_t samples) {
   return std::min(0.8, StructureOptions{}.radius * std::max(1.0, std::pow(40000.0 / n, 0.25)));
 }
 
-std::vector<Eigen::Matrix4d> local_hessians(const std::vector<Vec4>& x, const std::vector<double>& y,
-                                            const std::vector<double>& w, const StructureOptions& opt) {
+namespace {
+using Vec15 = Eigen::Matrix<double, 15, 1>;
+
+// Features about the centre, z = x - c: 1, z_i / r, z_i z_j / r^2 (i <= j): 15.
+Vec15 quadratic_features(const Vec4& z, double r, double r2) {
+  Vec15 f;
+  f[0] = 1;
+  for (int i = 0; i < 4; ++i) f[1 + i] = z[i] / r;
+  int m = 5;
+  for (int i = 0; i < 4; ++i)
+    for (int j = i; j < 4; ++j) f[m++] = z[i] * z[j] / r2;
+  return f;
+}
+}  // namespace
+
+LocalHessians::LocalHessians(const std::vector<Vec4>& x, const std::vector<double>& w, const StructureOptions& opt)
+    : x_(x), r_(opt.radius) {
   const size_t N = x.size();
-  if (y.size() != N || (!w.empty() && w.size() != N))
-    throw std::invalid_argument("local_hessians: x, y and w must have one entry per sample");
+  if (!w.empty() && w.size() != N)
+    throw std::invalid_argument("local_hessians: w has " + std::to_string(w.size()) +
+                                " values, expected one per sample (" + std::to_string(N) + ") or none");
   if (opt.centres < 1 || !(opt.radius > 0) || opt.min_neighbours < 15)
     throw std::invalid_argument("local_hessians: expected centres >= 1, radius > 0, min_neighbours >= 15");
-  std::vector<Eigen::Matrix4d> out;
-  if (N == 0) return out;
+  if (N == 0) return;
   // Buckets of side `radius`: a ball of that radius meets at most 3^4 of them.
   Vec4 lo = x[0];
   for (const Vec4& p : x) lo = lo.cwiseMin(p);
-  const double r = opt.radius, r2 = r * r;
+  const double r = r_, r2 = r * r;
   auto cell_of = [&](const Vec4& p) {
     std::array<int, 4> c;
     for (int i = 0; i < 4; ++i) c[i] = static_cast<int>(std::floor((p[i] - lo[i]) / r));
@@ -53,15 +69,11 @@ std::vector<Eigen::Matrix4d> local_hessians(const std::vector<Vec4>& x, const st
     }
     centres.resize(opt.centres);
   }
-  // Features about the centre c, z = x - c: 1, z_i, z_i z_j (i <= j): 15.
-  using Vec15 = Eigen::Matrix<double, 15, 1>;
-  using Mat15 = Eigen::Matrix<double, 15, 15>;
   for (size_t ci : centres) {
     const Vec4& c = x[ci];
     const auto cc = cell_of(c);
     Mat15 A = Mat15::Zero();
-    Vec15 b = Vec15::Zero();
-    int count = 0;
+    const size_t first = neighbours_.size();
     for (int d0 = -1; d0 <= 1; ++d0)
       for (int d1 = -1; d1 <= 1; ++d1)
         for (int d2 = -1; d2 <= 1; ++d2)
@@ -75,23 +87,40 @@ std::vector<Eigen::Matrix4d> local_hessians(const std::vector<Vec4>& x, const st
               const double t = 1 - d2z / r2;
               const double wk = t * t * (w.empty() ? 1.0 : w[k]);
               if (!(wk > 0)) continue;
-              Vec15 f;
-              f[0] = 1;
-              for (int i = 0; i < 4; ++i) f[1 + i] = z[i] / r;
-              int m = 5;
-              for (int i = 0; i < 4; ++i)
-                for (int j = i; j < 4; ++j) f[m++] = z[i] * z[j] / r2;
-              A.selfadjointView<Eigen::Lower>().rankUpdate(f, wk);
-              b += wk * y[k] * f;
-              ++count;
+              A.selfadjointView<Eigen::Lower>().rankUpdate(quadratic_features(z, r, r2), wk);
+              neighbours_.push_back(Neighbour{k, wk});
             }
           }
-    if (count < opt.min_neighbours) continue;
-    A.triangularView<Eigen::StrictlyUpper>() = A.transpose();
-    A.diagonal() *= 1 + 1e-10;
-    const Eigen::LDLT<Mat15> ldlt(A);
-    if (ldlt.info() != Eigen::Success) continue;
-    const Vec15 coef = ldlt.solve(b);
+    const size_t count = neighbours_.size() - first;
+    bool ok = count >= static_cast<size_t>(opt.min_neighbours);
+    if (ok) {
+      A.triangularView<Eigen::StrictlyUpper>() = A.transpose();
+      A.diagonal() *= 1 + 1e-10;
+      Centre centre{ci, first, count, Eigen::LDLT<Mat15>(A)};
+      if (centre.ldlt.info() == Eigen::Success) {
+        centres_.push_back(std::move(centre));
+        continue;
+      }
+    }
+    neighbours_.resize(first);  // a centre skipped keeps no neighbours
+  }
+}
+
+std::vector<Eigen::Matrix4d> LocalHessians::operator()(const std::vector<double>& y) const {
+  if (y.size() != x_.size())
+    throw std::invalid_argument("local_hessians: y has " + std::to_string(y.size()) +
+                                " values, expected one per sample (" + std::to_string(x_.size()) + ")");
+  const double r = r_, r2 = r * r;
+  std::vector<Eigen::Matrix4d> out;
+  out.reserve(centres_.size());
+  for (const Centre& centre : centres_) {
+    const Vec4& c = x_[centre.index];
+    Vec15 b = Vec15::Zero();
+    for (size_t i = centre.first; i < centre.first + centre.count; ++i) {
+      const Neighbour& nb = neighbours_[i];
+      b += nb.w * y[nb.k] * quadratic_features(x_[nb.k] - c, r, r2);
+    }
+    const Vec15 coef = centre.ldlt.solve(b);
     if (!coef.allFinite()) continue;
     Eigen::Matrix4d H;
     int m = 5;
@@ -104,6 +133,11 @@ std::vector<Eigen::Matrix4d> local_hessians(const std::vector<Vec4>& x, const st
     out.push_back(H);
   }
   return out;
+}
+
+std::vector<Eigen::Matrix4d> local_hessians(const std::vector<Vec4>& x, const std::vector<double>& y,
+                                            const std::vector<double>& w, const StructureOptions& opt) {
+  return LocalHessians(x, w, opt)(y);
 }
 
 namespace {

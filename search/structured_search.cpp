@@ -2,10 +2,12 @@
 #include "search/structured_search.h"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <thread>
 
 #include "search/structure.h"
@@ -94,6 +96,10 @@ class Structured {
     popt_[1].param = Parameterization::HalfDiff;
     if (opt.term_param == "fixed") params_ = {opt.param};
     else params_ = {Parameterization::WiWo, Parameterization::HalfDiff};
+    StructureOptions so;
+    so.seed = opt_.seed;
+    so.radius = structure_radius(d_.size());
+    for (Parameterization p : params_) hessians_[pidx(p)] = std::make_unique<LocalHessians>(d_.points(p), d_.w, so);
   }
 
   SearchResult run();
@@ -208,6 +214,8 @@ class Structured {
   int sres_;
   SearchOptions popt_[2];
   std::vector<Parameterization> params_;
+  // The Hessian estimator of each allowed parameterization's points (seeds()).
+  std::array<std::unique_ptr<LocalHessians>, 2> hessians_;
   int evaluations_ = 0;
 };
 
@@ -249,11 +257,8 @@ std::vector<double> Structured::residual(const std::vector<FactorTerm>& done) co
 
 std::vector<std::pair<Parameterization, PlaneSplit>> Structured::seeds(const std::vector<double>& y) const {
   std::vector<std::pair<Parameterization, PlaneSplit>> out;
-  StructureOptions so;
-  so.seed = opt_.seed;
-  so.radius = structure_radius(d_.size());
   for (Parameterization p : params_) {
-    const std::vector<Eigen::Matrix4d> hs = local_hessians(d_.points(p), y, d_.w, so);
+    const std::vector<Eigen::Matrix4d> hs = (*hessians_[pidx(p)])(y);
     if (hs.empty()) continue;
     out.emplace_back(p, split_planes(hs));
   }

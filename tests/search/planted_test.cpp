@@ -90,6 +90,49 @@ TEST_CASE("structure: local Hessians of a quadratic are its matrix") {
   for (const Eigen::Matrix4d& H : hs) CHECK((H - A).cwiseAbs().maxCoeff() < 1e-6);  // measured 6e-8
 }
 
+TEST_CASE("structure: one LocalHessians reads many functions - each call is a fresh estimate") {
+  // The structured search builds one estimator per sample set and reads the
+  // Hessians of every residual with it: a call must not depend on the calls
+  // before it, and must equal local_hessians (the same neighbours, weights
+  // and factorization) on weighted samples.
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> U(-1, 1);
+  std::vector<Vec4> x(12000);
+  std::vector<double> w(x.size());
+  for (size_t k = 0; k < x.size(); ++k) {
+    x[k] = Vec4(U(rng), U(rng), U(rng), U(rng));
+    w[k] = 0.5 + 0.5 * (U(rng) + 1);
+  }
+  StructureOptions so;
+  so.centres = 40;
+  so.radius = 0.5;
+  so.seed = 3;
+  const LocalHessians est(x, w, so);
+  std::vector<Eigen::Matrix4d> A(3);
+  std::vector<std::vector<double>> y(3, std::vector<double>(x.size()));
+  for (int f = 0; f < 3; ++f) {
+    for (int i = 0; i < 4; ++i)
+      for (int j = i; j < 4; ++j) A[f](i, j) = A[f](j, i) = U(rng);
+    for (size_t k = 0; k < x.size(); ++k) y[f][k] = 0.5 * x[k].dot(A[f] * x[k]) + x[k][f] - 2;
+  }
+  std::vector<std::vector<Eigen::Matrix4d>> first(3);
+  for (int f : {0, 1, 2, 1, 0}) {
+    const auto hs = est(y[f]);
+    const auto fresh = local_hessians(x, y[f], w, so);
+    REQUIRE(hs.size() == fresh.size());
+    REQUIRE(hs.size() >= 30);
+    for (size_t c = 0; c < hs.size(); ++c) {
+      INFO("function " << f << ", centre " << c);
+      CHECK(hs[c] == fresh[c]);                                 // bit for bit
+      CHECK((hs[c] - A[f]).cwiseAbs().maxCoeff() < 1e-6);       // the quadratic's matrix
+      if (!first[f].empty()) CHECK(hs[c] == first[f][c]);       // a repeat reads the same
+    }
+    if (first[f].empty()) first[f] = hs;
+  }
+  CHECK_THROWS_WITH(est(std::vector<double>(x.size() - 1)),
+                    Catch::Contains("y has 11999 values, expected one per sample (12000)"));
+}
+
 TEST_CASE("structure: split_planes recovers the planes of block-diagonal Hessians") {
   std::mt19937_64 rng(5);
   std::uniform_real_distribution<double> U(-1, 1);
