@@ -8,7 +8,8 @@ Each workload runs --rounds times; with --old, the two binaries alternate
 (old, new, old, new, ...) so that both see the same machine state, and the
 table reports the median of each. Timings are the benchmarks' own CPU
 medians (`cpu_ms_median` of `bench fit`), wall and CPU seconds of
-`bench search`, and `/usr/bin/time` for `--help`. The load average is printed
+`bench search` (W1, 5 terms, 6 restarts: the greedy and the structured search
+interleaved in each round, with their wall-time ratio round by round), and `/usr/bin/time` for `--help`. The load average is printed
 at the start and the end: figures taken while anything else runs are not
 comparable with idle ones (docs/speed.md).
 
@@ -33,7 +34,10 @@ WORKLOADS = [
     ("texture 32, ms (target 15)", FIT + ["--texture", "32", "--repeats", "7"], ("cpu_ms_median",)),
     ("texture 64, ms (target 300)", FIT + ["--texture", "64", "--repeats", "3"], ("cpu_ms_median",)),
 ]
-SEARCH = ["bench", "search", "--brdf", "bluepaint", "--terms", "5", "--restarts", "6", "--strategy", "greedy"]
+SEARCH = ["bench", "search", "--brdf", "bluepaint", "--terms", "5", "--restarts", "6", "--strategy"]
+# The W1 search of each strategy, interleaved in every round (greedy, structured,
+# greedy, ...): `best`, the config default, runs the two one after the other.
+STRATEGIES = ("greedy", "structured")
 
 
 def run_json(cmd):
@@ -74,19 +78,27 @@ def main():
                     f"{tag} {statistics.median(vals[(tag, key)]):.3f} {sorted(round(x, 3) for x in vals[(tag, key)])}"
                     for tag, _ in clis), flush=True)
     if "search" not in skip:
-        res = {tag: [] for tag, _ in clis}
+        res = {(tag, st): [] for tag, _ in clis for st in STRATEGIES}
         for _ in range(a.rounds):
-            for tag, c in reversed(clis):
-                res[tag].append(run_json([c] + SEARCH))
-        for tag, rs in res.items():
+            for st in STRATEGIES:
+                for tag, c in reversed(clis):
+                    res[(tag, st)].append(run_json([c] + SEARCH + [st]))
+        for (tag, st), rs in res.items():
             walls = [r["seconds"] for r in rs]
             cpus = [r["cpu_seconds"] for r in rs]
-            print(f"greedy W1 search (target 6 s wall) {tag}: wall {statistics.median(walls):.2f} s {sorted(round(w, 2) for w in walls)}, "
+            target = " (target 6 s wall)" if st == "greedy" else ""
+            print(f"{st} W1 search{target} {tag}: wall {statistics.median(walls):.2f} s {sorted(round(w, 2) for w in walls)}, "
                   f"CPU {statistics.median(cpus):.2f} s, evaluations {sorted(set(r['evaluations'] for r in rs))}, "
                   f"rel_mse after each term {rs[0]['rel_mse_after_term']}", flush=True)
+        for tag, _ in clis:
+            ratios = [s["seconds"] / g["seconds"] for g, s in zip(res[(tag, "greedy")], res[(tag, "structured")])]
+            print(f"structured / greedy wall, round by round {tag}: {[round(x, 2) for x in ratios]}, "
+                  f"median {statistics.median(ratios):.2f}", flush=True)
         if a.old:
-            diff = max(abs(x - y) for x, y in zip(res["new"][0]["rel_mse_after_term"], res["old"][0]["rel_mse_after_term"]))
-            print(f"largest per-term rel_mse difference new - old: {diff:.3g}", flush=True)
+            for st in STRATEGIES:
+                diff = max(abs(x - y) for x, y in zip(res[("new", st)][0]["rel_mse_after_term"],
+                                                       res[("old", st)][0]["rel_mse_after_term"]))
+                print(f"{st}: largest per-term rel_mse difference new - old: {diff:.3g}", flush=True)
     if "peer" not in skip:
         peer = run_json(["/usr/bin/python3", os.path.join(os.path.dirname(__file__), "bench-peer.py"),
                          "--rounds", str(max(5, a.rounds)), "--cli", a.cli])
