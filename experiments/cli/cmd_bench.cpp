@@ -542,9 +542,18 @@ void run_bench_planted(const BenchPlantedArgs& a) {
                      {"terms", found}, {"rel_mse_after_term", r.rel_mse_after_term}};
     }
     std::cout << j.dump() << std::endl;
-    std::fprintf(stderr, "| %s | %.4g | %.4g | %.4g | %.4g | %.1fx | %.2fx | %d | %d | %.1f | %.1f |\n",
-                 b.to_string().c_str(), em.back(), err[0], err[1], floor, err[0] / floor, err[1] / floor,
-                 fits[0], fits[1], secs[0], secs[1]);
+    // A strategy not run (--strategy greedy or structured) prints "-", not nan.
+    auto cell = [](double v, const char* fmt) {
+      if (!std::isfinite(v)) return std::string("-");
+      char buf[64];
+      std::snprintf(buf, sizeof buf, fmt, v);
+      return std::string(buf);
+    };
+    std::fprintf(stderr, "| %s | %.4g | %s | %s | %.4g | %s | %s | %s | %s | %s | %s |\n", b.to_string().c_str(),
+                 em.back(), cell(err[0], "%.4g").c_str(), cell(err[1], "%.4g").c_str(), floor,
+                 cell(err[0] / floor, "%.1fx").c_str(), cell(err[1] / floor, "%.2fx").c_str(),
+                 cell(fits[0] > 0 ? fits[0] : NAN, "%.0f").c_str(), cell(fits[1] > 0 ? fits[1] : NAN, "%.0f").c_str(),
+                 cell(secs[0], "%.1f").c_str(), cell(secs[1], "%.1f").c_str());
   }
 }
 

@@ -204,6 +204,26 @@ TEST_CASE("search parameterization: bench search follows the config's rule") {
   CHECK(j.at("term_parameterizations") == nlohmann::json::array({"wiwo", "wiwo"}));
 }
 
+TEST_CASE("search parameterization: bench planted prints a dash for the search it did not run and never nan") {
+  for (const char* strategy : {"structured", "greedy"}) {
+    INFO(strategy);
+    std::string out;
+    REQUIRE(run_cli(std::string("bench planted --count 1 --terms 2 --grid 6 --texture 6 --restarts 1 --threads 1 "
+                                "--strategy ") + strategy,
+                    &out) == 0);
+    INFO(out);
+    CHECK(out.find("nan") == std::string::npos);
+    const auto row = out.find("| planted-rotation(0, 2 terms, wiwo) |");
+    REQUIRE(row != std::string::npos);
+    const std::string line = out.substr(row, out.find('\n', row) - row);
+    // greedy, structured, the two ratios, fits and seconds: three cells of the
+    // search not run are "-", and the run one's are numbers.
+    size_t dashes = 0;
+    for (size_t at = line.find("| - |"); at != std::string::npos; at = line.find("| - |", at + 3)) ++dashes;
+    CHECK(dashes == 4);
+  }
+}
+
 TEST_CASE("search_samples: 0 and off disable the subsample and bad values are refused naming the key") {
   const std::string head = std::string(kConfigHead) + "[[method]]\nkind = \"search\"\nterms = 1\nsearch_samples = ";
   for (const char* bad : {"10", "-1", "999", "\"auto\"", "1.5", "true"}) {
