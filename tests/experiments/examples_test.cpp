@@ -14,7 +14,8 @@ const std::vector<std::string> kExamples = {
     "thesis-measured", "parameterizations", "baselines",          "bench-fit",
     "bench-search",    "bench-baselines", "refine",   "compare-storage",
     "sh-lighting",     "thesis-nongreedy", "thesis-bluepaint-mccool", "refine-blend", "thesis-retro", "thesis-ratio",
-    "cornell-validation", "shade-tolerance", "cornell-baselines", "validation-convergence"};
+    "cornell-validation", "shade-tolerance", "cornell-baselines", "validation-convergence",
+    "search-criterion-measured"};
 
 // Runs experiments/<name>.toml with the overrides; every run must succeed.
 void run_example(const std::string& name, const std::vector<std::string>& defines, size_t expected_runs) {
