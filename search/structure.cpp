@@ -36,7 +36,7 @@ Vec15 quadratic_features(const Vec4& z, double r, double r2) {
 }  // namespace
 
 LocalHessians::LocalHessians(const std::vector<Vec4>& x, const std::vector<double>& w, const StructureOptions& opt)
-    : x_(x), r_(opt.radius) {
+    : x_(x), w_(w), r_(opt.radius) {
   const size_t N = x.size();
   if (!w.empty() && w.size() != N)
     throw std::invalid_argument("local_hessians: w has " + std::to_string(w.size()) +
@@ -88,7 +88,7 @@ LocalHessians::LocalHessians(const std::vector<Vec4>& x, const std::vector<doubl
               const double wk = t * t * (w.empty() ? 1.0 : w[k]);
               if (!(wk > 0)) continue;
               A.selfadjointView<Eigen::Lower>().rankUpdate(quadratic_features(z, r, r2), wk);
-              neighbours_.push_back(Neighbour{k, wk});
+              neighbours_.push_back(k);
             }
           }
     const size_t count = neighbours_.size() - first;
@@ -117,8 +117,12 @@ std::vector<Eigen::Matrix4d> LocalHessians::operator()(const std::vector<double>
     const Vec4& c = x_[centre.index];
     Vec15 b = Vec15::Zero();
     for (size_t i = centre.first; i < centre.first + centre.count; ++i) {
-      const Neighbour& nb = neighbours_[i];
-      b += nb.w * y[nb.k] * quadratic_features(x_[nb.k] - c, r, r2);
+      // The weight as the constructor computed it (same operations, same bits).
+      const uint32_t k = neighbours_[i];
+      const Vec4 z = x_[k] - c;
+      const double t = 1 - z.squaredNorm() / r2;
+      const double wk = t * t * (w_.empty() ? 1.0 : w_[k]);
+      b += wk * y[k] * quadratic_features(z, r, r2);
     }
     const Vec15 coef = centre.ldlt.solve(b);
     if (!coef.allFinite()) continue;
