@@ -33,6 +33,14 @@ Vec15 quadratic_features(const Vec4& z, double r, double r2) {
     for (int j = i; j < 4; ++j) f[m++] = z[i] * z[j] / r2;
   return f;
 }
+
+// The neighbour's kernel weight (1 - d^2/r^2)^2 times its sample weight: one
+// definition for building the normal matrix and for reading a y, so both see
+// the same bits.
+double kernel_weight(double d2, double r2, const std::vector<double>& w, size_t k) {
+  const double t = 1 - d2 / r2;
+  return t * t * (w.empty() ? 1.0 : w[k]);
+}
 }  // namespace
 
 LocalHessians::LocalHessians(const std::vector<Vec4>& x, const std::vector<double>& w, const StructureOptions& opt)
@@ -84,16 +92,14 @@ LocalHessians::LocalHessians(const std::vector<Vec4>& x, const std::vector<doubl
               const Vec4 z = x[k] - c;
               const double d2z = z.squaredNorm();
               if (d2z >= r2) continue;
-              const double t = 1 - d2z / r2;
-              const double wk = t * t * (w.empty() ? 1.0 : w[k]);
+              const double wk = kernel_weight(d2z, r2, w, k);
               if (!(wk > 0)) continue;
               A.selfadjointView<Eigen::Lower>().rankUpdate(quadratic_features(z, r, r2), wk);
               neighbours_.push_back(k);
             }
           }
     const size_t count = neighbours_.size() - first;
-    bool ok = count >= static_cast<size_t>(opt.min_neighbours);
-    if (ok) {
+    if (count >= static_cast<size_t>(opt.min_neighbours)) {
       A.triangularView<Eigen::StrictlyUpper>() = A.transpose();
       A.diagonal() *= 1 + 1e-10;
       Centre centre{ci, first, count, Eigen::LDLT<Mat15>(A)};
@@ -117,12 +123,9 @@ std::vector<Eigen::Matrix4d> LocalHessians::operator()(const std::vector<double>
     const Vec4& c = x_[centre.index];
     Vec15 b = Vec15::Zero();
     for (size_t i = centre.first; i < centre.first + centre.count; ++i) {
-      // The weight as the constructor computed it (same operations, same bits).
       const uint32_t k = neighbours_[i];
       const Vec4 z = x_[k] - c;
-      const double t = 1 - z.squaredNorm() / r2;
-      const double wk = t * t * (w_.empty() ? 1.0 : w_[k]);
-      b += wk * y[k] * quadratic_features(z, r, r2);
+      b += kernel_weight(z.squaredNorm(), r2, w_, k) * y[k] * quadratic_features(z, r, r2);
     }
     const Vec15 coef = centre.ldlt.solve(b);
     if (!coef.allFinite()) continue;

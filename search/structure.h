@@ -43,7 +43,7 @@ std::vector<Eigen::Matrix4d> local_hessians(const std::vector<Vec4>& x, const st
                                             const std::vector<double>& w, const StructureOptions& opt);
 
 // local_hessians for many y on one sample set. The centres, their neighbours
-// (index and weight) and each centre's factorized normal matrix depend only on
+// (sample indices) and each centre's factorized normal matrix depend only on
 // x, w and opt, so they are found once here; each call then costs one pass
 // over the neighbours per centre (the structured search reads the Hessians of
 // every residual it seeds from: on W1's 5-term search the repeated neighbour
