@@ -116,6 +116,11 @@ class Structured {
   // The fit schedule at the search resolution: its error, and the texels.
   // n: terms solved jointly (0 = the option's solve_last).
   double schedule(const std::vector<Term>& ts, std::vector<FactorTerm>* done, int n = 0) const;
+  // n fits more, in the search's count and the term's record.
+  void count_fits(int n, TermRecord* rec) {
+    evaluations_ += n;
+    rec->evaluations += n;
+  }
   // Mean over channels of g minus the given terms' values (the residual log BRDF).
   std::vector<double> residual(const std::vector<FactorTerm>& done) const;
   // Seed plane pairs of a residual, one per allowed parameterization.
@@ -126,6 +131,11 @@ class Structured {
     double value = kInf;
     int start = 0;                 // index of the start of the last term
   };
+  // Removes the configs whose schedule failed (infinite value), keeping the order.
+  static void drop_failed(std::vector<Config>& cs) {
+    cs.erase(std::remove_if(cs.begin(), cs.end(), [](const Config& c) { return !std::isfinite(c.value); }),
+             cs.end());
+  }
   // One beam step: the configs after adding term j to each of `beam`.
   // n: terms solved jointly in this step's objective.
   // side: the previous k-term answer, extended greedily besides the beam (its
@@ -281,14 +291,18 @@ std::vector<Structured::Cand> Structured::screen(const std::vector<Config>& beam
   // The configs' seed planes, in parallel (independent; results by index).
   std::vector<std::vector<std::pair<Parameterization, PlaneSplit>>> seed_of(beam.size());
   parallel_for(beam.size(), opt_.threads, [&](size_t b) { seed_of[b] = seeds(residual(beam[b].done)); });
-  for (size_t b = 0; b < beam.size(); ++b) {
+  // Each parent's objectives (its fixed terms' sum and prefix), in parallel.
+  parallel_for(beam.size() * params_.size(), opt_.threads, [&](size_t k) {
+    const size_t b = k / params_.size();
+    const Parameterization p = params_[k % params_.size()];
     const Config& c = beam[b];
     const size_t first = first_joint(j, n);
     const std::vector<FactorTerm> fixed(c.done.begin(), c.done.begin() + first);
     std::vector<TermSpec> known;
     for (size_t i = first; i < static_cast<size_t>(j); ++i) known.push_back(spec(c.ts[i], sres_));
-    for (Parameterization p : params_)
-      obj[b][pidx(p)] = std::make_unique<TermObjective>(d_, fixed, known, popt_[pidx(p)], sres_);
+    obj[b][pidx(p)] = std::make_unique<TermObjective>(d_, fixed, known, popt_[pidx(p)], sres_);
+  });
+  for (size_t b = 0; b < beam.size(); ++b) {
     int index = 0;
     auto add = [&](const Rotation4& R, Parameterization p, bool seed) {
       cands.push_back(Cand{b, Start{Term{R, p}, kInf, index++}, seed});
@@ -410,17 +424,16 @@ std::vector<Structured::Config> Structured::next_beam(const std::vector<Config>&
   for (const Next& x : seeds_next) take(x, B);
   for (const Next& x : refined) take(x, B);
   for (const Next& x : others) take(x, B);
-  std::vector<Config> out;
-  for (const Next& x : chosen) {
-    Config c;
-    c.ts = beam[x.b].ts;
-    c.ts.push_back(x.t);
+  std::vector<Config> out(chosen.size());
+  parallel_for(chosen.size(), opt_.threads, [&](size_t k) {
+    Config& c = out[k];
+    c.ts = beam[chosen[k].b].ts;
+    c.ts.push_back(chosen[k].t);
     c.value = schedule(c.ts, &c.done, n);
-    c.start = x.start;
-    ++evaluations_;
-    ++rec->evaluations;
-    if (std::isfinite(c.value)) out.push_back(std::move(c));
-  }
+    c.start = chosen[k].start;
+  });
+  count_fits(static_cast<int>(chosen.size()), rec);
+  drop_failed(out);
   std::stable_sort(out.begin(), out.end(), [](const Config& a, const Config& b) { return a.value < b.value; });
   return out;
 }
@@ -460,17 +473,17 @@ std::vector<Structured::Config> Structured::step(const std::vector<Config>& beam
     rec->evaluations += r.evaluations;
   }
   if (side_out) {
-    side_out->clear();
-    for (size_t k = nb; k < refine.size(); ++k) {
-      Config c;
+    side_out->assign(refine.size() - nb, Config{});
+    parallel_for(refine.size() - nb, opt_.threads, [&](size_t i) {
+      const size_t k = nb + i;
+      Config& c = (*side_out)[i];
       c.ts = side->ts;
       c.ts.push_back(Term{res[k].best.normalized(), cands[refine[k]].s.t.p});
       c.value = schedule(c.ts, &c.done, n);
       c.start = cands[refine[k]].s.index;
-      ++evaluations_;
-      ++rec->evaluations;
-      if (std::isfinite(c.value)) side_out->push_back(std::move(c));
-    }
+    });
+    count_fits(static_cast<int>(refine.size() - nb), rec);
+    drop_failed(*side_out);
   }
   refine.resize(nb);
   res.resize(nb);
@@ -788,18 +801,24 @@ std::vector<Term> Structured::fill_answers(const std::vector<Term>& ts, const st
   out.rel_mse_after_term.resize(J);
   out.answers[J - 1] = final_f;
   out.rel_mse_after_term[J - 1] = errors[J - 1];
+  // Each k < J: stage k's best, or the prefix refit (in parallel).
+  std::vector<int> prefixes;
   for (int k = J - 1; k >= 1; --k) {
     const Answer& sb = stage_best[k - 1];
     if (sb.error < errors[k - 1]) {
       out.answers[k - 1] = sb.f;
       out.rel_mse_after_term[k - 1] = sb.error;
     } else {
-      const Answer a = answer_of(std::vector<Term>(answer_ts.begin(), answer_ts.begin() + k));
-      ++evaluations_;
-      out.answers[k - 1] = a.f;
-      out.rel_mse_after_term[k - 1] = a.error;
+      prefixes.push_back(k);
     }
   }
+  parallel_for(prefixes.size(), opt_.threads, [&](size_t i) {
+    const int k = prefixes[i];
+    const Answer a = answer_of(std::vector<Term>(answer_ts.begin(), answer_ts.begin() + k));
+    out.answers[k - 1] = a.f;
+    out.rel_mse_after_term[k - 1] = a.error;
+  });
+  evaluations_ += static_cast<int>(prefixes.size());
   return answer_ts;
 }
 
