@@ -23,22 +23,32 @@ double structure_radius(size_t samples) {
 namespace {
 using Vec15 = Eigen::Matrix<double, 15, 1>;
 
-// Features about the centre, z = x - c: 1, z_i / r, z_i z_j / r^2 (i <= j): 15.
-Vec15 quadratic_features(const Vec4& z, double r, double r2) {
-  Vec15 f;
-  f[0] = 1;
-  for (int i = 0; i < 4; ++i) f[1 + i] = z[i] / r;
+// Features about the centre in units of the radius, u = (x - c) / r:
+// 1, u_i, u_i u_j (i <= j): 15, passed to put(index, value) in that order.
+// inv_r = 1 / r (multiplications: a division per feature cost about half of
+// a Hessian read). One definition for building the normal matrix and for
+// reading a y.
+template <class Put>
+void for_each_feature(const Vec4& z, double inv_r, Put put) {
+  const double u[4] = {z[0] * inv_r, z[1] * inv_r, z[2] * inv_r, z[3] * inv_r};
+  put(0, 1.0);
+  for (int i = 0; i < 4; ++i) put(1 + i, u[i]);
   int m = 5;
   for (int i = 0; i < 4; ++i)
-    for (int j = i; j < 4; ++j) f[m++] = z[i] * z[j] / r2;
+    for (int j = i; j < 4; ++j) put(m++, u[i] * u[j]);
+}
+
+Vec15 quadratic_features(const Vec4& z, double inv_r) {
+  Vec15 f;
+  for_each_feature(z, inv_r, [&](int m, double v) { f[m] = v; });
   return f;
 }
 
-// The neighbour's kernel weight (1 - d^2/r^2)^2 times its sample weight: one
-// definition for building the normal matrix and for reading a y, so both see
-// the same bits.
-double kernel_weight(double d2, double r2, const std::vector<double>& w, size_t k) {
-  const double t = 1 - d2 / r2;
+// The neighbour's kernel weight (1 - d^2/r^2)^2 times its sample weight
+// (inv_r2 = 1 / r^2): one definition for building the normal matrix and for
+// reading a y, so both see the same bits.
+double kernel_weight(double d2, double inv_r2, const std::vector<double>& w, size_t k) {
+  const double t = 1 - d2 * inv_r2;
   return t * t * (w.empty() ? 1.0 : w[k]);
 }
 }  // namespace
@@ -55,7 +65,7 @@ LocalHessians::LocalHessians(const std::vector<Vec4>& x, const std::vector<doubl
   // Buckets of side `radius`: a ball of that radius meets at most 3^4 of them.
   Vec4 lo = x[0];
   for (const Vec4& p : x) lo = lo.cwiseMin(p);
-  const double r = r_, r2 = r * r;
+  const double r = r_, r2 = r * r, inv_r = 1 / r, inv_r2 = 1 / r2;
   auto cell_of = [&](const Vec4& p) {
     std::array<int, 4> c;
     for (int i = 0; i < 4; ++i) c[i] = static_cast<int>(std::floor((p[i] - lo[i]) / r));
@@ -92,9 +102,9 @@ LocalHessians::LocalHessians(const std::vector<Vec4>& x, const std::vector<doubl
               const Vec4 z = x[k] - c;
               const double d2z = z.squaredNorm();
               if (d2z >= r2) continue;
-              const double wk = kernel_weight(d2z, r2, w, k);
+              const double wk = kernel_weight(d2z, inv_r2, w, k);
               if (!(wk > 0)) continue;
-              A.selfadjointView<Eigen::Lower>().rankUpdate(quadratic_features(z, r, r2), wk);
+              A.selfadjointView<Eigen::Lower>().rankUpdate(quadratic_features(z, inv_r), wk);
               neighbours_.push_back(k);
             }
           }
@@ -110,23 +120,45 @@ LocalHessians::LocalHessians(const std::vector<Vec4>& x, const std::vector<doubl
     }
     neighbours_.resize(first);  // a centre skipped keeps no neighbours
   }
+  // Store the samples bucket by bucket (ascending index within a bucket), so
+  // a centre's neighbours are read from a few contiguous runs instead of
+  // scattered across the arrays. Same neighbours in the same order: same bits.
+  std::vector<std::pair<int64_t, uint32_t>> order(N);
+  for (size_t k = 0; k < N; ++k) order[k] = {key(cell_of(x[k])), static_cast<uint32_t>(k)};
+  std::sort(order.begin(), order.end());
+  std::vector<uint32_t> new_of(N);
+  perm_.resize(N);
+  for (size_t k = 0; k < N; ++k) {
+    perm_[k] = order[k].second;
+    new_of[order[k].second] = static_cast<uint32_t>(k);
+    x_[k] = x[order[k].second];
+    if (!w.empty()) w_[k] = w[order[k].second];
+  }
+  for (uint32_t& k : neighbours_) k = new_of[k];
+  for (Centre& c : centres_) c.index = new_of[c.index];
 }
 
 std::vector<Eigen::Matrix4d> LocalHessians::operator()(const std::vector<double>& y) const {
   if (y.size() != x_.size())
     throw std::invalid_argument("local_hessians: y has " + std::to_string(y.size()) +
                                 " values, expected one per sample (" + std::to_string(x_.size()) + ")");
-  const double r = r_, r2 = r * r;
+  const double r2 = r_ * r_, inv_r = 1 / r_, inv_r2 = 1 / r2;
+  std::vector<double> yb(y.size());  // y in the samples' stored (bucket) order
+  for (size_t k = 0; k < y.size(); ++k) yb[k] = y[perm_[k]];
   std::vector<Eigen::Matrix4d> out;
   out.reserve(centres_.size());
   for (const Centre& centre : centres_) {
     const Vec4& c = x_[centre.index];
-    Vec15 b = Vec15::Zero();
+    // b = sum of kernel weight * y * features, accumulated in place (a Vec15
+    // of features built per neighbour went through the stack and cost 2x).
+    double acc[15] = {};
     for (size_t i = centre.first; i < centre.first + centre.count; ++i) {
       const uint32_t k = neighbours_[i];
       const Vec4 z = x_[k] - c;
-      b += kernel_weight(z.squaredNorm(), r2, w_, k) * y[k] * quadratic_features(z, r, r2);
+      const double s = kernel_weight(z.squaredNorm(), inv_r2, w_, k) * yb[k];
+      for_each_feature(z, inv_r, [&](int m, double v) { acc[m] += s * v; });
     }
+    const Vec15 b = Eigen::Map<const Vec15>(acc);
     const Vec15 coef = centre.ldlt.solve(b);
     if (!coef.allFinite()) continue;
     Eigen::Matrix4d H;

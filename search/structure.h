@@ -70,6 +70,8 @@ class LocalHessians {
   // distance when read: 4 bytes a neighbour, about 22,000 neighbours a centre
   // on 3 million samples).
   std::vector<uint32_t> neighbours_;
+  // x_ and w_ are stored bucket by bucket: stored sample k is input sample perm_[k].
+  std::vector<uint32_t> perm_;
   std::vector<Centre> centres_;
 };
 
