@@ -151,6 +151,7 @@ class Structured {
     size_t b;
     Start s;
     bool seed;
+    bool greedy = false;  // one of the greedy search's starts (a random start or a configured guess)
   };
   using Objectives = std::vector<std::array<std::unique_ptr<TermObjective>, 2>>;
   static bool distinct(const std::vector<Cand>& cands, const std::vector<size_t>& chosen, size_t i);
@@ -304,8 +305,8 @@ std::vector<Structured::Cand> Structured::screen(const std::vector<Config>& beam
   });
   for (size_t b = 0; b < beam.size(); ++b) {
     int index = 0;
-    auto add = [&](const Rotation4& R, Parameterization p, bool seed) {
-      cands.push_back(Cand{b, Start{Term{R, p}, kInf, index++}, seed});
+    auto add = [&](const Rotation4& R, Parameterization p, bool seed, bool greedy = false) {
+      cands.push_back(Cand{b, Start{Term{R, p}, kInf, index++}, seed, greedy});
     };
     for (const auto& [p, sp] : seed_of[b]) {
       add(sp.first, p, true);
@@ -315,13 +316,15 @@ std::vector<Structured::Cand> Structured::screen(const std::vector<Config>& beam
     for (const std::string& g : opt_.guesses)
       if (std::find(guesses.begin(), guesses.end(), g) == guesses.end()) guesses.push_back(g);
     for (Parameterization p : params_)
-      for (const std::string& g : guesses) add(guess_rotation(g), p, true);
+      for (const std::string& g : guesses)
+        add(guess_rotation(g), p, true,
+            std::find(opt_.guesses.begin(), opt_.guesses.end(), g) != opt_.guesses.end());
     for (int r = 0; r < opt_.restarts; ++r) {
       std::mt19937_64 rng(opt_.seed * 1000003ull + j * 7919ull + r);
       const Rotation4 R = Rotation4::random(rng);
-      if (b < S) add(R, params_[r % params_.size()], false);
+      if (b < S) add(R, params_[r % params_.size()], false, true);
       else
-        for (Parameterization p : params_) add(R, p, false);  // the greedy search's starts, in each parameterization
+        for (Parameterization p : params_) add(R, p, false, true);  // the greedy search's starts, in each parameterization
     }
   }
   parallel_for(cands.size(), opt_.threads, [&](size_t i) {
@@ -357,6 +360,13 @@ std::vector<size_t> Structured::side_starts(const std::vector<Cand>& cands, cons
         return;
     side_refine.push_back(i);
   };
+  // The first term: Powell from every one of the greedy search's own starts
+  // (its random starts and configured guesses, in its parameterization), so
+  // the 1-term answer is never worse than the greedy search's with the same
+  // seed, restarts and parameterization (one-term searches are cheap).
+  if (side.ts.empty())
+    for (size_t i : order)
+      if (cands[i].b == S && cands[i].greedy && cands[i].s.t.p == opt_.param) choose(i);
   for (Parameterization p : params_)
     for (size_t i : order)
       if (cands[i].b == S && cands[i].s.t.p == p && distinct(cands, covered, i)) {

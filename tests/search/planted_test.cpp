@@ -417,14 +417,20 @@ void check_k_term_answers(const SampleSet& s, int terms, int texture, bool recip
   REQUIRE(r.answers.size() == static_cast<size_t>(terms));
   REQUIRE(r.rel_mse_after_term.size() == static_cast<size_t>(terms));
   CHECK(r.answers.back() == r.factorization);
-  std::vector<double> best_greedy(terms, 1e300);
+  std::vector<double> best_greedy(terms, 1e300), same_param(terms);
   for (Parameterization p : {Parameterization::WiWo, Parameterization::HalfDiff}) {
     SearchOptions g = opt;
     g.strategy = "greedy";
     g.param = p;
     const SearchResult rg = search_factorization(d, g);
     for (int k = 0; k < terms; ++k) best_greedy[k] = std::min(best_greedy[k], rg.rel_mse_after_term[k]);
+    if (p == opt.param) same_param = rg.rel_mse_after_term;
   }
+  // The first term runs Powell from every start of the greedy search with the
+  // same seed, restarts and parameterization: its answer is never worse, to
+  // rounding.
+  INFO("1 term: structured " << r.rel_mse_after_term[0] << ", greedy (same parameterization) " << same_param[0]);
+  CHECK(r.rel_mse_after_term[0] <= same_param[0] * (1 + 1e-9));
   for (int k = 0; k < terms; ++k) {
     INFO((k + 1) << " terms: structured " << r.rel_mse_after_term[k] << ", best greedy " << best_greedy[k]);
     // The k-term answer is a k-term factorization whose error is the one reported
@@ -459,6 +465,29 @@ TEST_CASE("structured search: every k-term answer is no worse than the greedy k-
   // measured BRDFs and term counts where the greedy search is better.
   const PlantedProductBrdf b = planted_rotation_brdf(0, 2, Parameterization::WiWo);
   check_k_term_answers(sample_grid(b, 10), 2, 8, false);
+}
+
+TEST_CASE("structured search: the 1-term answer is never worse than the greedy search at the same seed") {
+  // With one parameterization the old start selection (Powell from the `keep`
+  // best screened starts) missed the greedy search's best single plane on W1
+  // at every seed: 0.0913 against 0.0788 at seed 1 (grid 10, texture 8). The
+  // first term now runs Powell from every greedy start as well.
+  for (const char* spec : {"bluepaint", "cook-torrance"}) {
+    const BrdfPtr b = Catalogue::builtin().make(spec);
+    const FitData d(sample_grid(*b, 10), 1e-5);
+    for (uint64_t seed : {1, 2, 4}) {
+      SearchOptions opt = structured(1, 8);
+      opt.term_param = "fixed";
+      opt.seed = seed;
+      const SearchResult r = search_factorization(d, opt);
+      SearchOptions g = opt;
+      g.strategy = "greedy";
+      const SearchResult rg = search_factorization(d, g);
+      INFO(spec << " seed " << seed << ": structured " << r.rel_mse_after_term[0] << ", greedy "
+                << rg.rel_mse_after_term[0]);
+      CHECK(r.rel_mse_after_term[0] <= rg.rel_mse_after_term[0] * (1 + 1e-9));
+    }
+  }
 }
 
 TEST_CASE("structured search: term_param fixed puts every term and every k-term answer on the given parameterization") {
