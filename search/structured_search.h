@@ -39,7 +39,10 @@
 //    at texture_size and the best is stage k's answer; besides the beam, that
 //    answer is extended greedily (its random starts in each parameterization,
 //    Powell from the `keep` best screened ones, at least one per
-//    parameterization), and those extensions compete for the next answer.
+//    parameterization; at the first term from every start of the greedy
+//    search with the same seed, restarts and parameterization, so the 1-term
+//    answer is never worse than its), and those extensions compete for the
+//    next answer.
 //    SearchResult::answers[k-1] is the better of stage k's answer and the final
 //    answer's k-term prefix (refit jointly), so a 1- or 2-term answer is not
 //    bound to the terms chosen for the final count.
