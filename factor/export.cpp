@@ -59,11 +59,6 @@ std::vector<float> interleaved_texels(const FactorTerm& t) {
   return px;
 }
 
-double srgb_encode(double v) {
-  v = std::clamp(v, 0.0, 1.0);
-  return v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(v, 1.0 / 2.4) - 0.055;
-}
-
 // 8-bit preview (see export.h), size (R*block)^2: the heat colour map of
 // log10 of the factor value (mean over channels of exp(texel)) over the fixed
 // range [kPreviewLog10Min, kPreviewLog10Max], the same for every term.
