@@ -5,7 +5,7 @@ rel_mse after each term (results.csv `errors_after_term`, runs labelled
 "greedy" and "structured"), their ratio (bold where the structured mean is
 higher) and the method seconds summed over the seeds.
 
-    python3 scripts/search-criterion.py OUT   # OUT: the --out of experiments/search-criterion-measured.toml
+    python3 scripts/search-criterion.py OUT   # OUT: the --out of experiments/search-criterion-measured.toml or -grid.toml
 
 Only the standard library.
 """

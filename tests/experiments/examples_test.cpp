@@ -15,7 +15,7 @@ const std::vector<std::string> kExamples = {
     "bench-search",    "bench-baselines", "refine",   "compare-storage",
     "sh-lighting",     "thesis-nongreedy", "thesis-bluepaint-mccool", "refine-blend", "thesis-retro", "thesis-ratio",
     "cornell-validation", "shade-tolerance", "cornell-baselines", "validation-convergence",
-    "search-criterion-measured"};
+    "search-criterion-measured", "search-criterion-grid"};
 
 // Runs experiments/<name>.toml with the overrides; every run must succeed.
 void run_example(const std::string& name, const std::vector<std::string>& defines, size_t expected_runs) {
