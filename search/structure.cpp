@@ -54,7 +54,7 @@ double kernel_weight(double d2, double inv_r2, const std::vector<double>& w, siz
 }  // namespace
 
 LocalHessians::LocalHessians(const std::vector<Vec4>& x, const std::vector<double>& w, const StructureOptions& opt)
-    : x_(x), w_(w), r_(opt.radius) {
+    : r_(opt.radius) {
   const size_t N = x.size();
   if (!w.empty() && w.size() != N)
     throw std::invalid_argument("local_hessians: w has " + std::to_string(w.size()) +
@@ -74,8 +74,27 @@ LocalHessians::LocalHessians(const std::vector<Vec4>& x, const std::vector<doubl
   auto key = [](const std::array<int, 4>& c) {
     return (((static_cast<int64_t>(c[0]) * 1024 + c[1]) * 1024 + c[2]) * 1024) + c[3];
   };
-  std::unordered_map<int64_t, std::vector<uint32_t>> buckets;
-  for (size_t k = 0; k < N; ++k) buckets[key(cell_of(x[k]))].push_back(static_cast<uint32_t>(k));
+  // The samples are stored bucket by bucket (ascending input index within a
+  // bucket; stored sample k is input sample perm_[k]), so a bucket is one run
+  // of stored samples and a centre's neighbours are read from a few
+  // contiguous runs instead of scattered across the arrays. Same neighbours
+  // in the same order as scanning the input: same bits.
+  std::vector<std::pair<int64_t, uint32_t>> order(N);
+  for (size_t k = 0; k < N; ++k) order[k] = {key(cell_of(x[k])), static_cast<uint32_t>(k)};
+  std::sort(order.begin(), order.end());
+  std::vector<uint32_t> stored_of(N);
+  perm_.resize(N);
+  x_.resize(N);
+  if (!w.empty()) w_.resize(N);
+  std::unordered_map<int64_t, std::pair<uint32_t, uint32_t>> buckets;  // key -> [first, last) stored samples
+  for (uint32_t k = 0; k < N; ++k) {
+    const uint32_t in = order[k].second;
+    perm_[k] = in;
+    stored_of[in] = k;
+    x_[k] = x[in];
+    if (!w.empty()) w_[k] = w[in];
+    buckets.try_emplace(order[k].first, k, k).first->second.second = k + 1;
+  }
 
   std::vector<size_t> centres(N);
   for (size_t k = 0; k < N; ++k) centres[k] = k;
@@ -87,8 +106,9 @@ LocalHessians::LocalHessians(const std::vector<Vec4>& x, const std::vector<doubl
     }
     centres.resize(opt.centres);
   }
-  for (size_t ci : centres) {
-    const Vec4& c = x[ci];
+  for (size_t in : centres) {
+    const size_t ci = stored_of[in];
+    const Vec4& c = x_[ci];
     const auto cc = cell_of(c);
     Mat15 A = Mat15::Zero();
     const size_t first = neighbours_.size();
@@ -98,11 +118,11 @@ LocalHessians::LocalHessians(const std::vector<Vec4>& x, const std::vector<doubl
           for (int d3 = -1; d3 <= 1; ++d3) {
             const auto it = buckets.find(key({cc[0] + d0, cc[1] + d1, cc[2] + d2, cc[3] + d3}));
             if (it == buckets.end()) continue;
-            for (uint32_t k : it->second) {
-              const Vec4 z = x[k] - c;
+            for (uint32_t k = it->second.first; k < it->second.second; ++k) {
+              const Vec4 z = x_[k] - c;
               const double d2z = z.squaredNorm();
               if (d2z >= r2) continue;
-              const double wk = kernel_weight(d2z, inv_r2, w, k);
+              const double wk = kernel_weight(d2z, inv_r2, w_, k);
               if (!(wk > 0)) continue;
               A.selfadjointView<Eigen::Lower>().rankUpdate(quadratic_features(z, inv_r), wk);
               neighbours_.push_back(k);
@@ -120,22 +140,6 @@ LocalHessians::LocalHessians(const std::vector<Vec4>& x, const std::vector<doubl
     }
     neighbours_.resize(first);  // a centre skipped keeps no neighbours
   }
-  // Store the samples bucket by bucket (ascending index within a bucket), so
-  // a centre's neighbours are read from a few contiguous runs instead of
-  // scattered across the arrays. Same neighbours in the same order: same bits.
-  std::vector<std::pair<int64_t, uint32_t>> order(N);
-  for (size_t k = 0; k < N; ++k) order[k] = {key(cell_of(x[k])), static_cast<uint32_t>(k)};
-  std::sort(order.begin(), order.end());
-  std::vector<uint32_t> new_of(N);
-  perm_.resize(N);
-  for (size_t k = 0; k < N; ++k) {
-    perm_[k] = order[k].second;
-    new_of[order[k].second] = static_cast<uint32_t>(k);
-    x_[k] = x[order[k].second];
-    if (!w.empty()) w_[k] = w[order[k].second];
-  }
-  for (uint32_t& k : neighbours_) k = new_of[k];
-  for (Centre& c : centres_) c.index = new_of[c.index];
 }
 
 std::vector<Eigen::Matrix4d> LocalHessians::operator()(const std::vector<double>& y) const {

@@ -49,7 +49,7 @@ std::vector<Eigen::Matrix4d> local_hessians(const std::vector<Vec4>& x, const st
 // every residual it seeds from: on W1's 5-term search the repeated neighbour
 // search and normal matrices were about a third of its time). Results are
 // those of local_hessians bit for bit (same neighbours, same order, same
-// factorization). Keeps a copy of x and w.
+// factorization). Keeps a copy of x and w, in its own (bucket) order.
 class LocalHessians {
  public:
   LocalHessians(const std::vector<Vec4>& x, const std::vector<double>& w, const StructureOptions& opt);
@@ -70,7 +70,7 @@ class LocalHessians {
   // distance when read: 4 bytes a neighbour, about 22,000 neighbours a centre
   // on 3 million samples).
   std::vector<uint32_t> neighbours_;
-  // x_ and w_ are stored bucket by bucket: stored sample k is input sample perm_[k].
+  // x_ and w_ are stored bucket by bucket (the constructor): stored sample k is input sample perm_[k].
   std::vector<uint32_t> perm_;
   std::vector<Centre> centres_;
 };

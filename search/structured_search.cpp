@@ -331,8 +331,7 @@ std::vector<Structured::Cand> Structured::screen(const std::vector<Config>& beam
     Cand& c = cands[i];
     c.s.value = (*obj[c.b][pidx(c.s.t.p)])(c.s.t.R);
   });
-  evaluations_ += static_cast<int>(cands.size());
-  rec->evaluations += static_cast<int>(cands.size());
+  count_fits(static_cast<int>(cands.size()), rec);
   return cands;
 }
 
@@ -478,10 +477,7 @@ std::vector<Structured::Config> Structured::step(const std::vector<Config>& beam
     const Cand& c = cands[refine[k]];
     res[k] = powell_minimize(std::cref(*obj[c.b][pidx(c.s.t.p)]), c.s.t.R, opt_.powell);
   });
-  for (const PowellResult& r : res) {
-    evaluations_ += r.evaluations;
-    rec->evaluations += r.evaluations;
-  }
+  for (const PowellResult& r : res) count_fits(r.evaluations, rec);
   if (side_out) {
     side_out->assign(refine.size() - nb, Config{});
     parallel_for(refine.size() - nb, opt_.threads, [&](size_t i) {
