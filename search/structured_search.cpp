@@ -228,6 +228,8 @@ class Structured {
   // The Hessian estimator of each allowed parameterization's points (seeds()).
   std::array<std::unique_ptr<LocalHessians>, 2> hessians_;
   int evaluations_ = 0;
+  const int polish_sweeps_ = effective_polish_sweeps(opt_);
+  const int beam_width_ = effective_beam_width(opt_);
 };
 
 double Structured::schedule(const std::vector<Term>& ts, std::vector<FactorTerm>* done_out, int n) const {
@@ -403,7 +405,7 @@ std::vector<Structured::Config> Structured::next_beam(const std::vector<Config>&
     taken_seeds.push_back(i);
     (cands[i].seed ? seeds_next : others).push_back({cands[i].b, cands[i].s.t, cands[i].s.value, cands[i].s.index});
   }
-  const size_t B = static_cast<size_t>(opt_.beam_width);
+  const size_t B = static_cast<size_t>(beam_width_);
   std::vector<Next> chosen;
   // A configuration already chosen (same parameterizations, same planes in
   // order, whatever start or parent it came from) is not taken twice.
@@ -717,8 +719,8 @@ bool Structured::reseed_keep(std::vector<Term>& ts, double& value, std::vector<R
     if (found[i].value < value * (1 - 1e-6) && (pick == found.size() || found[i].value < found[pick].value)) pick = i;
   if (pick < found.size()) {
     Reseeded& f = found[pick];
-    polish(f.ts, f.value, 0, opt_.polish_sweeps, n, rec, opt_.powell);
-    polish(f.ts, f.value, 0, opt_.polish_sweeps, n, rec, fine);
+    polish(f.ts, f.value, 0, polish_sweeps_, n, rec, opt_.powell);
+    polish(f.ts, f.value, 0, polish_sweeps_, n, rec, fine);
     if (f.value < best * (1 - 1e-6)) {
       best = f.value;
       best_ts = f.ts;
@@ -887,11 +889,11 @@ SearchResult Structured::run() {
   const int J = static_cast<int>(ts.size());
   // A stopping rule may end the search early: its configs were scored with solve_last.
   const int n = J == opt_.terms ? n_final : opt_.fit.solve_last;
-  if (J >= 2 && opt_.polish_sweeps > 0) {
+  if (J >= 2 && polish_sweeps_ > 0) {
     // Under the schedule's objective, re-searching an early term re-solves every
     // later step; only the last solve's terms are polished there.
     const size_t from = n >= J ? 0 : static_cast<size_t>(J - n);
-    polish(ts, value, from, opt_.polish_sweeps, n, &records.back(), opt_.powell);
+    polish(ts, value, from, polish_sweeps_, n, &records.back(), opt_.powell);
     // Searches solved jointly as a whole (up to joint_polish_terms terms): a
     // fine polish. Powell's line search stops at a bracket of 0.02 rad, which
     // left McCool-form BRDFs 0.0003-0.0014 (plane distance) off the true
@@ -902,7 +904,7 @@ SearchResult Structured::run() {
       fine.line_tol = 1e-3;
       fine.initial_step = 0.05;
       fine.ftol = 1e-6;
-      polish(ts, value, 0, opt_.polish_sweeps, n, &records.back(), fine);
+      polish(ts, value, 0, polish_sweeps_, n, &records.back(), fine);
     }
   }
   // Searches of 3..kReseedTerms terms with a parameterization per term: the

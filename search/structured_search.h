@@ -21,7 +21,8 @@
 //  - polish: at the end, every term of the best configuration is re-searched
 //    with the others held (Jacobi sweeps, in parallel; a move is kept only if
 //    the re-solved objective is lower), polish_sweeps times or until nothing
-//    moves;
+//    moves; by default only searches of up to kSmallSearchTerms terms (they
+//    also keep the wider beam, term_search.h);
 //  - joint refit (final_joint): the found projections are refitted with all
 //    terms solved together; searches of up to joint_polish_terms terms also
 //    polish under that joint objective (the schedule's n = 2 solve cannot

@@ -29,6 +29,16 @@ double now_seconds() {
 }
 }  // namespace
 
+int effective_polish_sweeps(const SearchOptions& opt) {
+  if (opt.polish_sweeps >= 0) return opt.polish_sweeps;
+  return opt.terms <= kSmallSearchTerms ? 2 : 0;
+}
+
+int effective_beam_width(const SearchOptions& opt) {
+  if (opt.beam_width >= 1) return opt.beam_width;
+  return opt.terms <= kSmallSearchTerms ? 8 : 4;
+}
+
 void SearchOptions::validate() const {
   if (strategy != "structured" && strategy != "greedy" && strategy != "best")
     throw OptionError("strategy", "strategy: expected \"structured\", \"greedy\" or \"best\", found \"" +
@@ -36,11 +46,14 @@ void SearchOptions::validate() const {
   if (term_param != "either" && term_param != "fixed")
     throw OptionError("term_param", "term_param: expected \"either\" or \"fixed\", found \"" + term_param + "\"");
   if (keep < 1) throw OptionError("keep", "keep: expected >= 1, found " + std::to_string(keep));
-  if (beam_width < 1) throw OptionError("beam_width", "beam_width: expected >= 1, found " + std::to_string(beam_width));
+  if (beam_width < 0)
+    throw OptionError("beam_width", "beam_width: expected >= 1 (or 0, the default for the search's size), found " +
+                                        std::to_string(beam_width));
   if (joint_polish_terms < 0)
     throw OptionError("joint_polish_terms", "joint_polish_terms: expected >= 0, found " + std::to_string(joint_polish_terms));
-  if (polish_sweeps < 0)
-    throw OptionError("polish_sweeps", "polish_sweeps: expected >= 0, found " + std::to_string(polish_sweeps));
+  if (polish_sweeps < -1)
+    throw OptionError("polish_sweeps", "polish_sweeps: expected >= 0 (or -1, the default for the search's size), "
+                                       "found " + std::to_string(polish_sweeps));
   if (strategy != "greedy") {  // structured, and best (which runs the structured search too)
     const std::string who = "the " + strategy + " strategy";
     if (beam != 1)

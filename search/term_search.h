@@ -37,6 +37,12 @@ inline constexpr uint64_t kMaxTotalTexels = uint64_t(1) << 26;  // terms x textu
 // SearchOptions::search_samples: the default, and the smallest subsample allowed.
 inline constexpr size_t kDefaultSearchSamples = 100000;
 inline constexpr size_t kMinSearchSamples = 1000;
+// The structured search's default polish and beam (SearchOptions::polish_sweeps,
+// beam_width): a search of up to this many terms is polished and keeps the wide
+// beam. The planted two-plane search (2 terms) needs the beam of 8 (with 4 it
+// ends at 3.4x the floor); on 5-term searches (W1, the paints) the polish and
+// the wider beam cost about a third of the time for answers within 1.6%.
+inline constexpr int kSmallSearchTerms = 4;
 
 struct SearchOptions {
   // "structured" (structured_search.h: seeds read off the data's Hessians,
@@ -54,8 +60,13 @@ struct SearchOptions {
   // chosen by the search; "fixed" = every term reads `param`.
   std::string term_param = "either";
   int keep = 3;                         // structured: Powell runs per term (best screened starts), >= 1
-  int polish_sweeps = 2;                // structured: joint re-search sweeps at the end, >= 0
-  int beam_width = 8;                   // structured: partial configurations kept per step, >= 1
+  // Structured: the final polish's sweeps (>= 0) and the beam's width (>= 1).
+  // The defaults (-1 and 0) depend on the search's size: searches of up to
+  // kSmallSearchTerms terms polish with 2 sweeps and keep a beam of 8, longer
+  // ones do not polish and keep a beam of 4 (effective_polish_sweeps,
+  // effective_beam_width; docs/search.md "Config default").
+  int polish_sweeps = -1;
+  int beam_width = 0;
   bool final_joint = true;              // structured: the final refit solves all terms jointly
   // Structured, with final_joint: searches of up to this many terms also
   // polish under the joint objective (larger ones polish the schedule's), >= 0.
@@ -93,6 +104,11 @@ struct SearchOptions {
   size_t search_samples = kDefaultSearchSamples;
   void validate() const;                // throws naming the field, value and rule
 };
+
+// The polish sweeps and the beam width a structured search runs with: the
+// option when set, else the default for the search's size (kSmallSearchTerms).
+int effective_polish_sweeps(const SearchOptions& opt);
+int effective_beam_width(const SearchOptions& opt);
 
 struct TermRecord {
   std::array<double, 8> rotation;  // quaternion pair [S; T], each [w, x, y, z]

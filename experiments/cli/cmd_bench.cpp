@@ -766,9 +766,11 @@ void add_bench_search(CLI::App* bench) {
       ->capture_default_str();
   search->add_option("--keep", b->keep, "structured: Powell runs per term (best screened starts)")
       ->capture_default_str();
-  search->add_option("--beam-width", b->beam_width, "structured: configurations kept per step")
+  search->add_option("--beam-width", b->beam_width,
+                     "structured: configurations kept per step (0: 8 for searches of up to 4 terms, 4 above)")
       ->capture_default_str();
-  search->add_option("--polish-sweeps", b->polish_sweeps, "structured: joint re-search sweeps at the end")
+  search->add_option("--polish-sweeps", b->polish_sweeps,
+                     "structured: joint re-search sweeps at the end (-1: 2 for searches of up to 4 terms, 0 above)")
       ->capture_default_str();
   search->add_option("--perturb", b->perturb,
                      "multiply every sample value by 1 + p u, u uniform in [-1, 1] (fixed seed): "

@@ -140,8 +140,11 @@ const std::vector<KeySpec>& search_keys() {
                                 "(`either`), or every term reads `parameterization` (`fixed`)"),
                      "`\"fixed\"` when `parameterization` is given, else `\"either\"`"),
         int_key("keep", 1, 1000, "3", "structured: starts refined by Powell per term (the best by one fit each)"),
-        int_key("polish_sweeps", 0, 1000, "2", "structured: final sweeps re-searching each term with the others held"),
-        int_key("beam_width", 1, 1000, "8", "structured: partial configurations kept per term"),
+        with_default(int_key("polish_sweeps", 0, 1000, "",
+                             "structured: final sweeps re-searching each term with the others held"),
+                     "2 for searches of up to 4 terms, 0 above"),
+        with_default(int_key("beam_width", 1, 1000, "", "structured: partial configurations kept per term"),
+                     "8 for searches of up to 4 terms, 4 above"),
         bool_key("final_joint", "true", "structured: the final refit solves all terms jointly"),
         bool_key("reseed", "true",
                  "structured, 3-4 terms, `term_param = \"either\"`: re-read every term and pair of terms under the "
@@ -235,8 +238,8 @@ void record_options(const MethodVariant& m, json& o) {
     o["strategy"] = s.strategy;
     o["term_param"] = s.term_param;
     o["keep"] = s.keep;
-    o["polish_sweeps"] = s.polish_sweeps;
-    o["beam_width"] = s.beam_width;
+    o["polish_sweeps"] = effective_polish_sweeps(s);
+    o["beam_width"] = effective_beam_width(s);
     o["final_joint"] = s.final_joint;
     o["joint_polish_terms"] = s.joint_polish_terms;
     o["reseed"] = s.reseed;

@@ -138,6 +138,31 @@ TEST_CASE("search parameterization: the options say fixed exactly when the key i
   CHECK(plan.methods[0].options.dump() != plan.methods[2].options.dump());
 }
 
+TEST_CASE("search options: beam_width and polish_sweeps default by the search size and a set value is kept") {
+  register_loaders();
+  const Plan plan = parse_plan(std::string(kConfigHead) +
+                                   "[[method]]\nkind = \"search\"\nterms = 5\n"
+                                   "[[method]]\nkind = \"search\"\nterms = 5\nbeam_width = 8\npolish_sweeps = 2\n"
+                                   "[[method]]\nkind = \"search\"\nterms = 3\n",
+                               "cfg.toml");
+  REQUIRE(plan.methods.size() == 3);
+  const SearchOptions& a = homomorphic_options(plan.methods[0]).search;
+  const SearchOptions& b = homomorphic_options(plan.methods[1]).search;
+  const SearchOptions& c = homomorphic_options(plan.methods[2]).search;
+  CHECK(effective_beam_width(a) == 4);
+  CHECK(effective_polish_sweeps(a) == 0);
+  CHECK(b.beam_width == 8);
+  CHECK(b.polish_sweeps == 2);
+  CHECK(effective_beam_width(c) == 8);
+  CHECK(effective_polish_sweeps(c) == 2);
+  // The run id holds the values the search runs with.
+  CHECK(plan.methods[0].options["beam_width"] == 4);
+  CHECK(plan.methods[0].options["polish_sweeps"] == 0);
+  CHECK(plan.methods[1].options["beam_width"] == 8);
+  CHECK(plan.methods[2].options["polish_sweeps"] == 2);
+  CHECK(plan.methods[0].options.dump() != plan.methods[1].options.dump());
+}
+
 TEST_CASE("search parameterization: term_param either with an explicit parameterization is refused, naming both keys") {
   for (const std::string strategy : {"", "strategy = \"structured\"\n", "strategy = \"greedy\"\n"}) {
     INFO(strategy);

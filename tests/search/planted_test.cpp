@@ -490,6 +490,44 @@ TEST_CASE("structured search: the 1-term answer is never worse than the greedy s
   }
 }
 
+TEST_CASE("structured search: the beam and the polish follow the search size unless set") {
+  // Searches of up to kSmallSearchTerms (4) terms keep a beam of 8 and polish
+  // with 2 sweeps (the planted two-plane search needs the beam); longer ones a
+  // beam of 4 and no polish. A value the caller sets is used at every size.
+  SearchOptions o = structured(kSmallSearchTerms, 8);
+  CHECK(effective_beam_width(o) == 8);
+  CHECK(effective_polish_sweeps(o) == 2);
+  o.terms = kSmallSearchTerms + 1;
+  CHECK(effective_beam_width(o) == 4);
+  CHECK(effective_polish_sweeps(o) == 0);
+  o.beam_width = 8;
+  o.polish_sweeps = 1;
+  CHECK(effective_beam_width(o) == 8);
+  CHECK(effective_polish_sweeps(o) == 1);
+  o.terms = 2;
+  o.polish_sweeps = 0;
+  CHECK(effective_polish_sweeps(o) == 0);
+  // What the search runs: a 5-term search by default is the one with beam 4
+  // and no polish, bit for bit; an explicit polish_sweeps polishes it (its
+  // re-search fits are booked on the last term's record).
+  const BrdfPtr b = Catalogue::builtin().make("bluepaint");
+  const FitData d(sample_grid(*b, 8), 1e-5);
+  const SearchOptions def = structured(5, 6);
+  SearchOptions narrow = def;
+  narrow.beam_width = 4;
+  narrow.polish_sweeps = 0;
+  SearchOptions polished = def;
+  polished.polish_sweeps = 2;
+  const SearchResult r = search_factorization(d, def);
+  const SearchResult rn = search_factorization(d, narrow);
+  const SearchResult rp = search_factorization(d, polished);
+  CHECK(r.rel_mse_after_term == rn.rel_mse_after_term);
+  CHECK(r.evaluations == rn.evaluations);
+  CHECK(r.terms.back().backfit_evaluations == 0);
+  CHECK(rp.terms.back().backfit_evaluations > 0);
+  CHECK(rp.evaluations > r.evaluations);
+}
+
 TEST_CASE("structured search: term_param fixed puts every term and every k-term answer on the given parameterization") {
   // McCool's form mixes wiwo and halfdiff: with term_param = "either" the
   // structured search reads both points (the control), with "fixed" none of
