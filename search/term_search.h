@@ -40,8 +40,10 @@ inline constexpr size_t kMinSearchSamples = 1000;
 // The structured search's default polish and beam (SearchOptions::polish_sweeps,
 // beam_width): a search of up to this many terms is polished and keeps the wide
 // beam. The planted two-plane search (2 terms) needs the beam of 8 (with 4 it
-// ends at 3.4x the floor); on 5-term searches (W1, the paints) the polish and
-// the wider beam cost about a third of the time for answers within 1.6%.
+// ends at 3.4x the floor); on 5-term searches the polish and the wider beam
+// cost about a third of the time for answers within 1.6% on the paints and
+// 2.4% on W1 (Cook-Torrance's 5-term mean over seeds 1-3 rose 23%, still
+// 0.17x greedy's; docs/search.md "Search size").
 inline constexpr int kSmallSearchTerms = 4;
 
 struct SearchOptions {
