@@ -153,7 +153,7 @@ def test_unknown_and_mistyped_options_are_named(grid8):
     with pytest.raises(ValueError, match=r"^search: beam: expected 1..\(restarts \+ guesses\) = 1..2, found 9$"):
         bf.search(grid8, restarts=2, beam=9)
     with pytest.raises(ValueError, match=r"^search: restarts: restarts = 0 and no guesses leave nothing to search from"):
-        bf.search(grid8, restarts=0)
+        bf.search(grid8, strategy="greedy", restarts=0)
     with pytest.raises(ValueError, match=r"^svd: eps: eps applies only to the log-space SVD"):
         bf.svd(bf.brdf("lambert"), eps=1e-3)
     with pytest.raises(ValueError, match=r"^mccool: tolerance.metric: expected one of"):

@@ -135,8 +135,10 @@ TEST_CASE("config: each rule broken gives one message with file:line, field and 
                 {"cfg.toml:12: method[0].tolerance.metric: expected one of"});
   }
   SECTION("search with nothing to start from") {
-    require_one_config_error(std::string(kBase) + "[[method]]\nkind = \"search\"\nrestarts = 0\n",
-                {"cfg.toml:12: method[0].restarts:", "nothing to search from"});
+    // The greedy search starts only from restarts and guesses (the structured
+    // one, the default, also from the data's Hessians, so restarts = 0 is valid there).
+    require_one_config_error(std::string(kBase) + "[[method]]\nkind = \"search\"\nstrategy = \"greedy\"\nrestarts = 0\n",
+                {"cfg.toml:13: method[0].restarts:", "nothing to search from"});
   }
   SECTION("unknown BRDF parameter, at its own line") {
     require_one_config_error("[[brdf]]\nmodel = \"blinn-phong\"\nn = 10\nshininess = 3\n[[method]]\nkind = \"mccool\"\n",
@@ -361,9 +363,9 @@ TEST_CASE("config: the CLI prints one line per problem and exits 2") {
 TEST_CASE("config: non-greedy search keys (beam, backfit) are read, validated, and keep greedy run ids") {
   const std::string greedy = std::string(kBase) + "[[method]]\nkind = \"search\"\nstrategy = \"greedy\"\nrestarts = 3\n";
   const Plan g = plan_of(greedy);
-  // Without a strategy, a greedy-only key selects the greedy search (the default is "best").
+  // Without a strategy, a greedy-only key selects the greedy search (the default is "structured").
   CHECK(homomorphic_options(plan_of(std::string(kBase) + "[[method]]\nkind = \"search\"\nrestarts = 3\n").methods[0]).search.strategy ==
-        "best");
+        "structured");
   CHECK(homomorphic_options(plan_of(std::string(kBase) + "[[method]]\nkind = \"search\"\nbeam = 1\n").methods[0]).search.strategy ==
         "greedy");
   const Plan g1 = plan_of(greedy + "beam = 1\nbackfit_sweeps = 0\n");
