@@ -446,7 +446,11 @@ struct BenchPlantedArgs {
   int solve_last = 2;
   int beam_width = SearchOptions{}.beam_width;
   int keep = SearchOptions{}.keep;
+  uint64_t seed = SearchOptions{}.seed;
   std::string strategy = "both";
+  // Mixed family: the variants run (--terms / --parameterization given:
+  // only that term count / main parameterization; default both of each).
+  bool mixed_terms_given = false, mixed_param_given = false;
 };
 
 // The planted family: per member, McCool's error, the greedy and the
@@ -465,7 +469,9 @@ void run_bench_planted(const BenchPlantedArgs& a) {
     if (a.family != "mixed") members.push_back({i, a.terms, a.param});
     else
       for (int t : {3, 4})
-        for (const char* p : {"wiwo", "halfdiff"}) members.push_back({i, t, p});
+        for (const char* p : {"wiwo", "halfdiff"})
+          if ((!a.mixed_terms_given || t == a.terms) && (!a.mixed_param_given || a.param == p))
+            members.push_back({i, t, p});
   }
   const bool joint_floor = a.floor == "joint" || a.family == "mixed";
   for (const Member& m : members) {
@@ -525,6 +531,7 @@ void run_bench_planted(const BenchPlantedArgs& a) {
       opt.texture_size = a.texture;
       opt.restarts = a.restarts;
       opt.threads = a.threads;
+      opt.seed = a.seed;
       const SearchResult r = search_factorization(d, opt);
       err[k] = r.rel_mse_after_term.back();
       secs[k] = r.seconds;
@@ -831,19 +838,33 @@ void add_bench_planted(CLI::App* bench) {
       ->capture_default_str();
   planted->add_option("--count", pa->count, "members")->capture_default_str();
   planted->add_option("--first", pa->first, "index of the first member")->capture_default_str();
-  planted->add_option("--terms", pa->terms, "rotation family: 2, 3 or 4 terms")->capture_default_str();
-  planted->add_option("--parameterization", pa->param, "rotation family: wiwo or halfdiff")->capture_default_str();
+  planted->add_option("--terms", pa->terms, "rotation family: 2, 3 or 4 terms; mixed family: run only 3 or 4")
+      ->capture_default_str();
+  planted->add_option("--parameterization", pa->param,
+                      "rotation family: wiwo or halfdiff; mixed family: run only this main parameterization")
+      ->check(CLI::IsMember({"wiwo", "halfdiff"}))
+      ->capture_default_str();
   planted->add_option("--grid", pa->grid, "regular res^4 parabolic grid")->capture_default_str();
   planted->add_option("--texture", pa->texture, "texture resolution (search and floor)")->capture_default_str();
   planted->add_option("--restarts", pa->restarts, "random starts per term")->capture_default_str();
   planted->add_option("--solve-last", pa->solve_last, "terms solved jointly (n), search and floor")->capture_default_str();
   planted->add_option("--beam-width", pa->beam_width, "structured: configurations kept per step")->capture_default_str();
   planted->add_option("--keep", pa->keep, "structured: Powell runs per step")->capture_default_str();
+  planted->add_option("--seed", pa->seed, "seed of the searches' random starts")->capture_default_str();
   planted->add_option("--threads", pa->threads, "threads (0 = all cores)")->capture_default_str();
   planted->add_option("--strategy", pa->strategy, "greedy, structured or both")
       ->check(CLI::IsMember({"structured", "greedy", "both"}))
       ->capture_default_str();
-  planted->callback([pa] { run_bench_planted(*pa); });
+  planted->callback([pa, planted] {
+    if (pa->family == "mixed") {
+      pa->mixed_terms_given = planted->get_option("--terms")->count() > 0;
+      pa->mixed_param_given = planted->get_option("--parameterization")->count() > 0;
+      if (pa->mixed_terms_given && pa->terms != 3 && pa->terms != 4)
+        throw std::invalid_argument("--terms: the mixed family has members of 3 and 4 terms; found " +
+                                    std::to_string(pa->terms));
+    }
+    run_bench_planted(*pa);
+  });
 }
 
 // "bench extrapolation": bounded extrapolation of measured BRDFs.

@@ -249,6 +249,24 @@ TEST_CASE("search parameterization: bench planted prints a dash for the search i
   }
 }
 
+TEST_CASE("search parameterization: bench planted --family mixed runs only the term count and parameterization given") {
+  std::string out;
+  REQUIRE(run_cli("bench planted --family mixed --count 1 --terms 3 --parameterization halfdiff --grid 6 --texture 6 "
+                  "--restarts 1 --threads 1 --strategy greedy",
+                  &out) == 0);
+  INFO(out);
+  // One member row (of the family's four variants), the one asked for.
+  std::vector<std::string> rows;
+  for (size_t at = out.find("| planted"); at != std::string::npos; at = out.find("| planted", at + 1))
+    rows.push_back(out.substr(at, out.find('\n', at) - at));
+  REQUIRE(rows.size() == 1);
+  CHECK(rows[0].find("3 terms") != std::string::npos);
+  CHECK(rows[0].find("halfdiff") != std::string::npos);
+  // The family has 3- and 4-term members only.
+  CHECK(run_cli("bench planted --family mixed --count 1 --terms 5 --grid 6 --texture 6", &out) == 2);
+  CHECK(out.find("--terms: the mixed family has members of 3 and 4 terms; found 5") != std::string::npos);
+}
+
 TEST_CASE("search_samples: 0 and off disable the subsample and bad values are refused naming the key") {
   const std::string head = std::string(kConfigHead) + "[[method]]\nkind = \"search\"\nterms = 1\nsearch_samples = ";
   for (const char* bad : {"10", "-1", "999", "\"auto\"", "1.5", "true"}) {
