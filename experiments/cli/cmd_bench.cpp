@@ -432,6 +432,11 @@ void run_bench_lines(const BenchLinesArgs& a) {
   std::cout << j.dump() << std::endl;
 }
 
+// --beam-width of bench search and bench planted (SearchOptions::beam_width's
+// default 0 picks the width by the search's size, effective_beam_width).
+constexpr const char* kBeamWidthHelp =
+    "structured: configurations kept per step (0: 8 for searches of up to 4 terms, 4 above)";
+
 struct BenchPlantedArgs {
   std::string family = "rotation";  // or "mccool", "mixed"
   std::string floor = "schedule";   // or "joint" (the mixed family's)
@@ -773,9 +778,7 @@ void add_bench_search(CLI::App* bench) {
       ->capture_default_str();
   search->add_option("--keep", b->keep, "structured: Powell runs per term (best screened starts)")
       ->capture_default_str();
-  search->add_option("--beam-width", b->beam_width,
-                     "structured: configurations kept per step (0: 8 for searches of up to 4 terms, 4 above)")
-      ->capture_default_str();
+  search->add_option("--beam-width", b->beam_width, kBeamWidthHelp)->capture_default_str();
   search->add_option("--polish-sweeps", b->polish_sweeps,
                      "structured: joint re-search sweeps at the end (-1: 2 for searches of up to 4 terms, 0 above)")
       ->capture_default_str();
@@ -848,7 +851,7 @@ void add_bench_planted(CLI::App* bench) {
   planted->add_option("--texture", pa->texture, "texture resolution (search and floor)")->capture_default_str();
   planted->add_option("--restarts", pa->restarts, "random starts per term")->capture_default_str();
   planted->add_option("--solve-last", pa->solve_last, "terms solved jointly (n), search and floor")->capture_default_str();
-  planted->add_option("--beam-width", pa->beam_width, "structured: configurations kept per step")->capture_default_str();
+  planted->add_option("--beam-width", pa->beam_width, kBeamWidthHelp)->capture_default_str();
   planted->add_option("--keep", pa->keep, "structured: Powell runs per step")->capture_default_str();
   planted->add_option("--seed", pa->seed, "seed of the searches' random starts")->capture_default_str();
   planted->add_option("--threads", pa->threads, "threads (0 = all cores)")->capture_default_str();
