@@ -31,12 +31,17 @@ double now_seconds() {
 
 int effective_polish_sweeps(const SearchOptions& opt) {
   if (opt.polish_sweeps >= 0) return opt.polish_sweeps;
-  return opt.terms <= kSmallSearchTerms ? 2 : 0;
+  return opt.terms <= kSmallSearchTerms ? kSmallSearchPolishSweeps : kLargeSearchPolishSweeps;
 }
 
 int effective_beam_width(const SearchOptions& opt) {
   if (opt.beam_width >= 1) return opt.beam_width;
-  return opt.terms <= kSmallSearchTerms ? 8 : 4;
+  return opt.terms <= kSmallSearchTerms ? kSmallSearchBeamWidth : kLargeSearchBeamWidth;
+}
+
+std::string by_search_size(int small, int large) {
+  return std::to_string(small) + " for searches of up to " + std::to_string(kSmallSearchTerms) + " terms, " +
+         std::to_string(large) + " above";
 }
 
 void SearchOptions::validate() const {

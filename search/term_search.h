@@ -45,6 +45,13 @@ inline constexpr size_t kMinSearchSamples = 1000;
 // 2.4% on W1 (Cook-Torrance's 5-term mean over seeds 1-3 rose 23%, still
 // 0.17x greedy's; docs/search.md "Search size").
 inline constexpr int kSmallSearchTerms = 4;
+// Those defaults: for searches of up to kSmallSearchTerms terms, and above.
+inline constexpr int kSmallSearchPolishSweeps = 2;
+inline constexpr int kLargeSearchPolishSweeps = 0;
+inline constexpr int kSmallSearchBeamWidth = 8;
+inline constexpr int kLargeSearchBeamWidth = 4;
+// "8 for searches of up to 4 terms, 4 above" (help texts of such defaults).
+std::string by_search_size(int small, int large);
 
 struct SearchOptions {
   // "structured" (structured_search.h: seeds read off the data's Hessians,

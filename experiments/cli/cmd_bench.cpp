@@ -434,8 +434,10 @@ void run_bench_lines(const BenchLinesArgs& a) {
 
 // --beam-width of bench search and bench planted (SearchOptions::beam_width's
 // default 0 picks the width by the search's size, effective_beam_width).
-constexpr const char* kBeamWidthHelp =
-    "structured: configurations kept per step (0: 8 for searches of up to 4 terms, 4 above)";
+std::string beam_width_help() {
+  return "structured: configurations kept per step (0: " + by_search_size(kSmallSearchBeamWidth, kLargeSearchBeamWidth) +
+         ")";
+}
 
 struct BenchPlantedArgs {
   std::string family = "rotation";  // or "mccool", "mixed"
@@ -778,9 +780,10 @@ void add_bench_search(CLI::App* bench) {
       ->capture_default_str();
   search->add_option("--keep", b->keep, "structured: Powell runs per term (best screened starts)")
       ->capture_default_str();
-  search->add_option("--beam-width", b->beam_width, kBeamWidthHelp)->capture_default_str();
+  search->add_option("--beam-width", b->beam_width, beam_width_help())->capture_default_str();
   search->add_option("--polish-sweeps", b->polish_sweeps,
-                     "structured: joint re-search sweeps at the end (-1: 2 for searches of up to 4 terms, 0 above)")
+                     "structured: joint re-search sweeps at the end (-1: " +
+                         by_search_size(kSmallSearchPolishSweeps, kLargeSearchPolishSweeps) + ")")
       ->capture_default_str();
   search->add_option("--perturb", b->perturb,
                      "multiply every sample value by 1 + p u, u uniform in [-1, 1] (fixed seed): "
@@ -851,7 +854,7 @@ void add_bench_planted(CLI::App* bench) {
   planted->add_option("--texture", pa->texture, "texture resolution (search and floor)")->capture_default_str();
   planted->add_option("--restarts", pa->restarts, "random starts per term")->capture_default_str();
   planted->add_option("--solve-last", pa->solve_last, "terms solved jointly (n), search and floor")->capture_default_str();
-  planted->add_option("--beam-width", pa->beam_width, kBeamWidthHelp)->capture_default_str();
+  planted->add_option("--beam-width", pa->beam_width, beam_width_help())->capture_default_str();
   planted->add_option("--keep", pa->keep, "structured: Powell runs per step")->capture_default_str();
   planted->add_option("--seed", pa->seed, "seed of the searches' random starts")->capture_default_str();
   planted->add_option("--threads", pa->threads, "threads (0 = all cores)")->capture_default_str();

@@ -142,9 +142,9 @@ const std::vector<KeySpec>& search_keys() {
         int_key("keep", 1, 1000, "3", "structured: starts refined by Powell per term (the best by one fit each)"),
         with_default(int_key("polish_sweeps", 0, 1000, "",
                              "structured: final sweeps re-searching each term with the others held"),
-                     "2 for searches of up to 4 terms, 0 above"),
+                     by_search_size(kSmallSearchPolishSweeps, kLargeSearchPolishSweeps)),
         with_default(int_key("beam_width", 1, 1000, "", "structured: partial configurations kept per term"),
-                     "8 for searches of up to 4 terms, 4 above"),
+                     by_search_size(kSmallSearchBeamWidth, kLargeSearchBeamWidth)),
         bool_key("final_joint", "true", "structured: the final refit solves all terms jointly"),
         bool_key("reseed", "true",
                  "structured, 3-4 terms, `term_param = \"either\"`: re-read every term and pair of terms under the "
