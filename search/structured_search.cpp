@@ -179,7 +179,9 @@ class Structured {
   // planes, in each parameterization, replace the term or the pair; the
   // replacement is read again from its own joint fit (alternating seeds and
   // fits) while that lowers the objective. The best replacement is polished
-  // and kept if the joint objective falls; rounds until nothing moves.
+  // and kept if the joint objective falls; rounds until nothing moves (at
+  // most 4). The first round, and a round after one that changed a term's
+  // parameterization, also restarts pairs (reseed_pair_restarts).
   // value: the joint objective of ts on return.
   void reseed(std::vector<Term>& ts, double& value, TermRecord* rec);
   // One candidate of reseed: its terms, joint objective and fits spent.
@@ -194,8 +196,10 @@ class Structured {
   std::vector<Reseeded> reseed_replacements(const std::vector<Term>& ts, const std::vector<FactorTerm>& done,
                                             double value, const std::vector<std::vector<size_t>>& subsets, int n,
                                             std::vector<std::array<double, 2>>& pair_read);
-  // reseed's pair restarts (first round; see there), appended to found.
-  void reseed_pair_restarts(const std::vector<Term>& ts, double value,
+  // reseed's pair restarts (the first round, and a round after one that
+  // changed the terms' parameterizations; see there), appended to found;
+  // `round` varies the random frames.
+  void reseed_pair_restarts(const std::vector<Term>& ts, double value, int round,
                             const std::vector<std::vector<size_t>>& subsets,
                             const std::vector<std::array<double, 2>>& pair_read, int n,
                             std::vector<Reseeded>& found);
@@ -607,7 +611,8 @@ std::vector<Structured::Reseeded> Structured::reseed_replacements(
   return found;
 }
 
-// Pair restarts (first round): two terms of one parameterization may sit
+// Pair restarts (the first round, and every round after one that changed
+// some term's parameterization): two terms of one parameterization may sit
 // in a mixed local minimum (each plane part of both true planes) that no
 // move of one term, and no Powell over their common frame from the
 // current pair or from the residual's split, leaves (planted mixed member
@@ -618,7 +623,7 @@ std::vector<Structured::Reseeded> Structured::reseed_replacements(
 // compete with the replacements below. The screened value of a random
 // frame does not predict which one reaches the true pair (measured), so
 // every start gets a Powell run.
-void Structured::reseed_pair_restarts(const std::vector<Term>& ts, double value,
+void Structured::reseed_pair_restarts(const std::vector<Term>& ts, double value, int round,
                                       const std::vector<std::vector<size_t>>& subsets,
                                       const std::vector<std::array<double, 2>>& pair_read, int n,
                                       std::vector<Reseeded>& found) {
@@ -663,7 +668,7 @@ void Structured::reseed_pair_restarts(const std::vector<Term>& ts, double value,
           (pick == subsets.size() || pair_read[si][pidx(p)] < pair_read[pick][pidx(p)]))
         pick = si;
     if (pick == subsets.size()) continue;
-    std::mt19937_64 rng(opt_.seed * 1000003ull + 0x9a17ull + pidx(p));
+    std::mt19937_64 rng(opt_.seed * 1000003ull + 0x9a17ull + pidx(p) + 0x100ull * round);
     for (int r = 0; r < kPairRestarts; ++r)
       starts.push_back({subsets[pick][0], subsets[pick][1], p, Rotation4::random(rng), &ts});
   }
@@ -683,7 +688,7 @@ void Structured::reseed_pair_restarts(const std::vector<Term>& ts, double value,
       const Parameterization q = moved_p0 ? params_[1] : params_[0];
       const std::vector<size_t>& other = moved_p0 ? B : A;
       const std::vector<Term> base = found[best].ts;
-      std::mt19937_64 rng(opt_.seed * 1000003ull + 0x9a19ull + pidx(q));
+      std::mt19937_64 rng(opt_.seed * 1000003ull + 0x9a19ull + pidx(q) + 0x100ull * round);
       std::vector<PairStart> again;
       for (int r = 0; r < kPairRestarts; ++r) again.push_back({other[0], other[1], q, Rotation4::random(rng), &base});
       run_pairs(again);
@@ -748,10 +753,11 @@ void Structured::reseed(std::vector<Term>& ts, double& value, TermRecord* rec) {
   fine.line_tol = 1e-3;
   fine.initial_step = 0.05;
   fine.ftol = 1e-6;
+  bool restart_pairs = true;
   for (int round = 0; round < 4; ++round) {
     std::vector<std::array<double, 2>> pair_read;
     std::vector<Reseeded> found = reseed_replacements(ts, done, value, subsets, n, pair_read);
-    if (round == 0) reseed_pair_restarts(ts, value, subsets, pair_read, n, found);
+    if (restart_pairs) reseed_pair_restarts(ts, value, round, subsets, pair_read, n, found);
     std::vector<size_t> order(found.size());
     for (size_t i = 0; i < order.size(); ++i) order[i] = i;
     std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return found[a].value < found[b].value; });
@@ -759,7 +765,14 @@ void Structured::reseed(std::vector<Term>& ts, double& value, TermRecord* rec) {
       evaluations_ += f.fits;
       rec->backfit_evaluations += f.fits;
     }
+    std::vector<Parameterization> mix;
+    for (const Term& t : ts) mix.push_back(t.p);
     if (!reseed_keep(ts, value, found, order, n, fine, rec)) break;
+    // A new mix of parameterizations gives new pairs of one parameterization,
+    // which may sit in the mixed local minimum the pair restarts leave
+    // (planted mixed member 3, 4 terms: w w w h became h w w h on wrong planes).
+    restart_pairs = false;
+    for (size_t i = 0; i < ts.size(); ++i) restart_pairs = restart_pairs || ts[i].p != mix[i];
     value = schedule(ts, &done, n);
     ++evaluations_;
     ++rec->backfit_evaluations;
