@@ -89,7 +89,8 @@ and exports.)doc")
           "to (scored with metric_eps), or None (tabulating method without samples, reloaded export)")
       .def_readonly("metric_eps", &PyFactorization::metric_eps)
       .def_readonly("errors_after_term", &PyFactorization::errors_after_term,
-                    "homomorphic methods: rel_mse on the fit data after each term")
+                    "homomorphic methods: rel_mse on the fit data after each term (a structured search: element "
+                    "k is its own k-term answer's error, not a prefix of this factorization)")
       .def_readonly("seconds", &PyFactorization::seconds, "wall time of the method")
       .def_readonly("evaluations", &PyFactorization::evaluations, "search: inner-loop fits; model-fit: LM iterations")
       .def_property_readonly("info", [](const PyFactorization& f) { return to_python(f.info); },
