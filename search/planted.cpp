@@ -1,6 +1,7 @@
 // Planted product BRDFs (see planted.h).
 #include "search/planted.h"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -37,6 +38,13 @@ Rgb PlantedProductBrdf::eval(const Vec3& wi, const Vec3& wo) const {
   double s = 0;
   for (const PlantedTerm& t : terms_) s += t.a(t.P * to_point(t.param, wi, wo));
   return Rgb(1.0, 0.8, 0.6) * std::exp(s);
+}
+
+double PlantedProductBrdf::nearest_plane_distance(Parameterization param, const Mat24& P) const {
+  double dist = 2;
+  for (const PlantedTerm& t : terms_)
+    if (t.param == param) dist = std::min(dist, 2 - (P * t.P.transpose()).squaredNorm());
+  return dist;
 }
 
 std::vector<TermSpec> PlantedProductBrdf::specs(int res) const {

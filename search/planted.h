@@ -44,6 +44,10 @@ class PlantedProductBrdf final : public Brdf {
   const std::vector<PlantedTerm>& terms() const { return terms_; }
   // The true projections as fit specs at texture res (for the floor: fit at them).
   std::vector<TermSpec> specs(int res) const;
+  // The distance 2 - |P P_true^T|_F^2 from plane P (orthonormal rows) to the
+  // nearest true plane of parameterization `param`: 0 for a true plane, 2 when
+  // no term reads `param`.
+  double nearest_plane_distance(Parameterization param, const Mat24& P) const;
 
  private:
   std::vector<PlantedTerm> terms_;

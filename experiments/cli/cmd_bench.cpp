@@ -546,12 +546,9 @@ void run_bench_planted(const BenchPlantedArgs& a) {
       // Per found term: its parameterization and the distance of its plane to
       // the nearest true plane of that parameterization (2 - |P P_true^T|^2, 0 = same plane).
       nlohmann::json found = nlohmann::json::array();
-      for (const FactorTerm& t : r.factorization->terms()) {
-        double dist = 2;
-        for (const PlantedTerm& pt : b.terms())
-          if (pt.param == t.proj.param) dist = std::min(dist, 2 - (t.proj.P * pt.P.transpose()).squaredNorm());
-        found.push_back({{"parameterization", to_string(t.proj.param)}, {"plane_distance", dist}});
-      }
+      for (const FactorTerm& t : r.factorization->terms())
+        found.push_back({{"parameterization", to_string(t.proj.param)},
+                         {"plane_distance", b.nearest_plane_distance(t.proj.param, t.proj.P)}});
       j[names[k]] = {{"rel_mse", err[k]},  {"evaluations", r.evaluations}, {"seconds", r.seconds},
                      {"terms", found}, {"rel_mse_after_term", r.rel_mse_after_term}};
     }

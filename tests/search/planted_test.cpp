@@ -331,6 +331,19 @@ TEST_CASE("planted: the 4-term member has two planes in each parameterization") 
   CHECK_THROWS_AS(planted_rotation_brdf(0, 5, Parameterization::WiWo), std::invalid_argument);
 }
 
+TEST_CASE("planted: nearest_plane_distance is 0 at a true plane and counts only its parameterization") {
+  const PlantedProductBrdf b = planted_rotation_brdf(0, 3, Parameterization::WiWo);  // w, w, h
+  for (const PlantedTerm& t : b.terms()) CHECK(b.nearest_plane_distance(t.param, t.P) == Approx(0).margin(1e-12));
+  // The halfdiff plane read as wiwo is compared with the two wiwo planes only.
+  const Mat24& h = b.terms()[2].P;
+  CHECK(b.nearest_plane_distance(Parameterization::WiWo, h) ==
+        Approx(std::min(plane_distance(h, b.terms()[0].P), plane_distance(h, b.terms()[1].P))));
+  CHECK(b.nearest_plane_distance(Parameterization::WiWo, h) > 1e-3);
+  // No term of a parameterization: the largest distance.
+  const PlantedProductBrdf two = planted_rotation_brdf(0, 2, Parameterization::WiWo);
+  CHECK(two.nearest_plane_distance(Parameterization::HalfDiff, two.terms()[0].P) == 2);
+}
+
 TEST_CASE("structured search: mixed planted family ends near the joint floor", "[slow]") {
   // Two planes in one parameterization and one (3 terms) or two (4 terms) in
   // the other; 16^4 grid, texture 16. The floor is the fit at all true planes
@@ -370,9 +383,7 @@ TEST_CASE("structured search: a new mix of parameterizations gets its own pair r
   // Every found plane is a true plane of its parameterization.
   REQUIRE(r.factorization->terms().size() == 4);
   for (const FactorTerm& t : r.factorization->terms()) {
-    double dist = 2;
-    for (const PlantedTerm& pt : b.terms())
-      if (pt.param == t.proj.param) dist = std::min(dist, plane_distance(t.proj.P, pt.P));
+    const double dist = b.nearest_plane_distance(t.proj.param, t.proj.P);
     INFO(to_string(t.proj.param) << " term, distance to the nearest true plane " << dist);
     CHECK(dist < 0.01);
   }
