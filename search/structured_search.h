@@ -18,7 +18,9 @@
 //    guess configurations. Keeping the unrefined true planes is what undoes
 //    the greedy trap: a single plane refined to mix one direction of each
 //    true plane fits better alone, but its pair fits worse;
-//  - polish: at the end, every term of the best configuration is re-searched
+//  - polish: at the end, every term of the best configuration (the lower of
+//    the beam's best and the last stage's answer, which may be a side
+//    configuration; see below) is re-searched
 //    with the others held (Jacobi sweeps, in parallel; a move is kept only if
 //    the re-solved objective is lower), polish_sweeps times or until nothing
 //    moves; by default only searches of up to kSmallSearchTerms terms (they
