@@ -131,7 +131,9 @@ class Structured {
   // Mean over channels of g minus the given terms' values (the residual log BRDF).
   std::vector<double> residual(const std::vector<FactorTerm>& done) const;
   // Seed plane pairs of a residual, one per allowed parameterization.
-  std::vector<std::pair<Parameterization, PlaneSplit>> seeds(const std::vector<double>& y) const;
+  // only: that parameterization's seed alone (if allowed).
+  std::vector<std::pair<Parameterization, PlaneSplit>> seeds(const std::vector<double>& y,
+                                                             const Parameterization* only = nullptr) const;
   struct Config {
     std::vector<Term> ts;
     std::vector<FactorTerm> done;  // the schedule's texels at the search resolution
@@ -185,8 +187,9 @@ class Structured {
   // textures (of the joint fit) are removed from g and that residual's seed
   // planes, in each parameterization, replace the term or the pair; the
   // replacement is read again from its own joint fit (alternating seeds and
-  // fits) while that lowers the objective. The best replacement is polished
-  // and kept if the joint objective falls; rounds until nothing moves (at
+  // fits, in that parameterization) while that lowers the objective. The best
+  // replacement (and each other mix's best within 2x) is polished and the
+  // lowest kept if the joint objective falls; rounds until nothing moves (at
   // most 4). The first round, and a round after one that changed a term's
   // parameterization, also restarts pairs (reseed_pair_restarts).
   // value: the joint objective of ts on return.
@@ -198,8 +201,14 @@ class Structured {
     int fits = 0;
   };
   // reseed's replacements of each subset (a term or a pair) of ts, whose joint
-  // fit is `done` at `value`; pair_read[si][p]: the joint objective of pair
-  // si's first replacement in parameterization p.
+  // fit is `done` at `value`, one per subset and allowed parameterization
+  // (element si * params_.size() + the parameterization's position; each
+  // chain reads its own parameterization's seeds only: keeping the lower of
+  // the two per subset hid every replacement that changes the mix, e.g.
+  // planted mixed member 8, 3 terms, wiwo, seed 1, stayed w w w at 19.4x the
+  // joint floor while its term 0 read as halfdiff, within 2x, polishes to
+  // the true planes); pair_read[si][p]: the joint objective of pair si's
+  // first replacement in parameterization p.
   std::vector<Reseeded> reseed_replacements(const std::vector<Term>& ts, const std::vector<FactorTerm>& done,
                                             double value, const std::vector<std::vector<size_t>>& subsets, int n,
                                             std::vector<std::array<double, 2>>& pair_read);
@@ -279,9 +288,11 @@ std::vector<double> Structured::residual(const std::vector<FactorTerm>& done) co
   return y;
 }
 
-std::vector<std::pair<Parameterization, PlaneSplit>> Structured::seeds(const std::vector<double>& y) const {
+std::vector<std::pair<Parameterization, PlaneSplit>> Structured::seeds(const std::vector<double>& y,
+                                                                       const Parameterization* only) const {
   std::vector<std::pair<Parameterization, PlaneSplit>> out;
   for (Parameterization p : params_) {
+    if (only && p != *only) continue;
     const std::vector<Eigen::Matrix4d> hs = (*hessians_[pidx(p)])(y);
     if (hs.empty()) continue;
     out.emplace_back(p, split_planes(hs));
@@ -566,12 +577,14 @@ void Structured::polish(std::vector<Term>& ts, double& value, size_t from, int s
 std::vector<Structured::Reseeded> Structured::reseed_replacements(
     const std::vector<Term>& ts, const std::vector<FactorTerm>& done, double value,
     const std::vector<std::vector<size_t>>& subsets, int n, std::vector<std::array<double, 2>>& pair_read) {
-  const size_t J = ts.size();
-  std::vector<Reseeded> found(subsets.size());
+  const size_t J = ts.size(), P = params_.size();
+  std::vector<Reseeded> found(subsets.size() * P);
   pair_read.assign(subsets.size(), {kInf, kInf});
-  parallel_for(subsets.size(), opt_.threads, [&](size_t si) {
+  parallel_for(found.size(), opt_.threads, [&](size_t q) {
+    const size_t si = q / P;
+    const Parameterization only = params_[q % P];
     const std::vector<size_t>& S = subsets[si];
-    Reseeded& f = found[si];
+    Reseeded& f = found[q];
     std::vector<Term> cur = ts;
     std::vector<FactorTerm> cdone = done;
     double cv = value;
@@ -582,7 +595,7 @@ std::vector<Structured::Reseeded> Structured::reseed_replacements(
       std::vector<Term> best_ts;
       std::vector<FactorTerm> best_done;
       double best = kInf;
-      for (const auto& [p, sp] : seeds(residual(others))) {
+      for (const auto& [p, sp] : seeds(residual(others), &only)) {
         std::vector<std::vector<Term>> trials;
         if (S.size() == 2) {
           trials.push_back(cur);

@@ -33,7 +33,9 @@
 //  - re-seeding (searches of 3 or 4 terms, per-term parameterization, with
 //    final_joint): under the joint objective, every term and every pair of
 //    terms is read again from the residual of the others' jointly fitted
-//    textures, in each parameterization (alternating seeds and fits); the best
+//    textures, in each parameterization separately (alternating seeds and
+//    fits, one chain per parameterization, so a replacement that changes the
+//    mix is not discarded for a lower one that keeps it); the best
 //    replacement, and the best of each other mix of parameterizations within
 //    2x, are polished and the lowest kept, rounds until nothing moves. The
 //    beam alone missed planes that do not share a parameterization (a halfdiff
