@@ -206,7 +206,8 @@ class Structured {
   };
   // reseed's replacements of each subset (a term or a pair) of ts, whose joint
   // fit is `done` at `value`, one per subset and allowed parameterization
-  // (element si * params_.size() + the parameterization's position; each
+  // (element si * params_.size() + the parameterization's position; the
+  // lower of a subset's replacements is its primary one; each
   // chain reads its own parameterization's seeds only: keeping the lower of
   // the two per subset hid every replacement that changes the mix, e.g.
   // planted mixed member 8, 3 terms, wiwo, seed 1, stayed w w w at 19.4x the

@@ -37,7 +37,8 @@
 //    fits, one chain per parameterization, so a replacement that changes the
 //    mix is not discarded for a lower one that keeps it); the best
 //    replacement, and the best of each other mix of parameterizations within
-//    2x, are polished and the lowest kept, rounds until nothing moves. The
+//    2x (a subset's higher replacement only for a mix no other candidate
+//    has), are polished and the lowest kept, rounds until nothing moves. The
 //    beam alone missed planes that do not share a parameterization (a halfdiff
 //    term perturbs the wiwo Hessians and the reverse).
 //  - k-term answers: after term k, every configuration of the beam is refit
