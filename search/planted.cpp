@@ -43,7 +43,7 @@ Rgb PlantedProductBrdf::eval(const Vec3& wi, const Vec3& wo) const {
 double PlantedProductBrdf::nearest_plane_distance(Parameterization param, const Mat24& P) const {
   double dist = 2;
   for (const PlantedTerm& t : terms_)
-    if (t.param == param) dist = std::min(dist, 2 - (P * t.P.transpose()).squaredNorm());
+    if (t.param == param) dist = std::min(dist, plane_distance(P, t.P));
   return dist;
 }
 

@@ -147,4 +147,6 @@ Rotation4 guess_rotation(const std::string& name) {
   return Rotation4::from_matrix(M);
 }
 
+double plane_distance(const Mat24& a, const Mat24& b) { return 2 - (a * b.transpose()).squaredNorm(); }
+
 }  // namespace bf

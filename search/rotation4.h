@@ -84,4 +84,8 @@ std::array<Rotation4, 6> cole_basis_directions();
 // (e1 -> e3, e2 -> e4) and wi + wo (e1 -> (e1 + e3)/sqrt 2, e2 -> (e2 + e4)/sqrt 2).
 Rotation4 guess_rotation(const std::string& name);
 
+// The distance 2 - |A B^T|_F^2 between the planes spanned by the orthonormal
+// rows of A and B: 0 for the same plane, 2 for orthogonal planes.
+double plane_distance(const Mat24& a, const Mat24& b);
+
 }  // namespace bf

@@ -44,9 +44,6 @@ double joint_floor_error(const PlantedProductBrdf& b, const FitData& d, int res)
   return e.back();
 }
 
-// 2 - |P_a P_b^T|_F^2: 0 for the same plane.
-double plane_distance(const Mat24& a, const Mat24& b) { return 2 - (a * b.transpose()).squaredNorm(); }
-
 Mat24 plane_of(const Rotation4& R) { return R.projection(Parameterization::WiWo, 8).P; }
 
 SearchOptions structured(int terms, int texture) {
