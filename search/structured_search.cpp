@@ -228,6 +228,17 @@ class Structured {
   // and the one kept; true (ts, value updated) when the joint objective fell.
   bool reseed_keep(std::vector<Term>& ts, double& value, std::vector<Reseeded>& found,
                    const std::vector<size_t>& order, int n, const PowellOptions& fine, TermRecord* rec);
+  // After reseed's rounds: every term moved alone to the other
+  // parameterization, from the residual's seed there (both planes of its
+  // split read, the lower kept), and searched by Powell under the joint
+  // objective with the others held. The lowest, if below now, gets the full
+  // polish and is kept if it stays lower; true (ts, value updated) then.
+  // A term in the wrong parameterization on a wrong plane reads far above
+  // now at its seed, before its plane settles (planted mixed member 7, 3
+  // terms, halfdiff, seed 1: the wrong halfdiff term read as wiwo seeds at
+  // 0.027-0.030, 5x now, so reseed_keep's within-2x rule never polished it,
+  // and Powell from that seed reaches the true wiwo plane at 0.0013).
+  bool reseed_switch(std::vector<Term>& ts, double& value, int n, const PowellOptions& fine, TermRecord* rec);
   // A k-term answer: its terms, their refit at texture_size and its error.
   struct Answer {
     std::vector<Term> ts;
@@ -772,6 +783,61 @@ bool Structured::reseed_keep(std::vector<Term>& ts, double& value, std::vector<R
   return moved;
 }
 
+bool Structured::reseed_switch(std::vector<Term>& ts, double& value, int n, const PowellOptions& fine,
+                               TermRecord* rec) {
+  const size_t J = ts.size();
+  std::vector<FactorTerm> done;
+  if (!std::isfinite(schedule(ts, &done, n))) return false;
+  SearchOptions po[2] = {popt_[0], popt_[1]};
+  po[0].fit.solve_last = po[1].fit.solve_last = n;
+  std::vector<Reseeded> found(J);
+  parallel_for(J, opt_.threads, [&](size_t i) {
+    const Parameterization p = ts[i].p == Parameterization::WiWo ? Parameterization::HalfDiff : Parameterization::WiWo;
+    std::vector<FactorTerm> others;
+    std::vector<TermSpec> other_specs;
+    for (size_t k = 0; k < J; ++k)
+      if (k != i) {
+        others.push_back(done[k]);
+        other_specs.push_back(spec(ts[k], sres_));
+      }
+    Reseeded& f = found[i];
+    for (const auto& [sp_p, sp] : seeds(residual(others), &p))
+      for (const Rotation4& R : {sp.first, sp.second}) {
+        std::vector<Term> t = ts;
+        t[i] = Term{R, sp_p};
+        const double v = schedule(t, nullptr, n);
+        ++f.fits;
+        if (v < f.value) {
+          f.value = v;
+          f.ts = std::move(t);
+        }
+      }
+    if (!std::isfinite(f.value)) return;
+    const TermObjective objective(d_, {}, other_specs, po[pidx(p)], sres_);
+    const PowellResult r = powell_minimize(std::cref(objective), f.ts[i].R, opt_.powell);
+    f.fits += r.evaluations;
+    if (r.value < f.value) {
+      f.ts[i].R = r.best.normalized();
+      f.value = schedule(f.ts, nullptr, n);
+      ++f.fits;
+    }
+  });
+  size_t pick = J;
+  for (size_t i = 0; i < J; ++i) {
+    evaluations_ += found[i].fits;
+    rec->backfit_evaluations += found[i].fits;
+    if (found[i].value < value * (1 - 1e-6) && (pick == J || found[i].value < found[pick].value)) pick = i;
+  }
+  if (pick == J) return false;
+  Reseeded& f = found[pick];
+  polish(f.ts, f.value, 0, polish_sweeps_, n, rec, opt_.powell);
+  polish(f.ts, f.value, 0, polish_sweeps_, n, rec, fine);
+  if (!(f.value < value * (1 - 1e-6))) return false;
+  ts = f.ts;
+  value = f.value;
+  return true;
+}
+
 void Structured::reseed(std::vector<Term>& ts, double& value, TermRecord* rec) {
   const double t0 = now_seconds();
   const size_t J = ts.size();
@@ -812,6 +878,8 @@ void Structured::reseed(std::vector<Term>& ts, double& value, TermRecord* rec) {
     value = schedule(ts, &done, n);
     ++evaluations_;
     ++rec->backfit_evaluations;
+  }
+  for (size_t k = 0; k < J && reseed_switch(ts, value, n, fine, rec); ++k) {
   }
   rec->seconds += now_seconds() - t0;
 }

@@ -419,6 +419,19 @@ TEST_CASE("structured search: re-seeding keeps a replacement that changes the mi
   CHECK(wiwo == 2);
 }
 
+TEST_CASE("structured search: re-seeding moves a term alone to the other parameterization", "[slow]") {
+  // Mixed member 7, 3 terms, halfdiff main parameterization (two halfdiff
+  // terms, one wiwo), seed 1. Re-seeding ended at h h h, one halfdiff term
+  // 0.76 from any true plane, 12.6x the joint floor: that term read as wiwo
+  // seeds at 0.027-0.030, 5x the objective then, so no round polished it.
+  // Powell on that term alone in wiwo from the seed reaches the true wiwo
+  // plane (reseed_switch): 0.62x, every plane within 0.001.
+  const SearchResult r = check_mixed_member(7, 3, Parameterization::HalfDiff, 2.0, 0.005);
+  int wiwo = 0;
+  for (const FactorTerm& t : r.factorization->terms()) wiwo += t.proj.param == Parameterization::WiWo;
+  CHECK(wiwo == 1);
+}
+
 TEST_CASE("structured search: McCool's form is inside the search space and survives export") {
   // f = p(wi) q(h) p(wo): three terms, wiwo, wiwo and halfdiff. Grid 10,
   // texture 8; measured 0.89x and 1.05x McCool's error on members 0 and 1
