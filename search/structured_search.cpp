@@ -228,7 +228,11 @@ class Structured {
   // and the one kept; true (ts, value updated) when the joint objective fell.
   bool reseed_keep(std::vector<Term>& ts, double& value, std::vector<Reseeded>& found,
                    const std::vector<size_t>& order, int n, const PowellOptions& fine, TermRecord* rec);
-  // After reseed's rounds: every term moved alone to the other
+  // The full polish of a re-seeding candidate (coarse, then fine); true, and
+  // ts and value set to it, if it ends below value.
+  bool keep_if_lower(Reseeded& f, std::vector<Term>& ts, double& value, int n, const PowellOptions& fine,
+                     TermRecord* rec);
+  // After reseed's rounds (ts's joint fit is done): every term moved alone to the other
   // parameterization, from the residual's seed there (both planes of its
   // split read, the lower kept), and searched by Powell under the joint
   // objective with the others held. The lowest, if below now, gets the full
@@ -238,7 +242,8 @@ class Structured {
   // terms, halfdiff, seed 1: the wrong halfdiff term read as wiwo seeds at
   // 0.027-0.030, 5x now, so reseed_keep's within-2x rule never polished it,
   // and Powell from that seed reaches the true wiwo plane at 0.0013).
-  bool reseed_switch(std::vector<Term>& ts, double& value, int n, const PowellOptions& fine, TermRecord* rec);
+  bool reseed_switch(std::vector<Term>& ts, const std::vector<FactorTerm>& done, double& value, int n,
+                     const PowellOptions& fine, TermRecord* rec);
   // A k-term answer: its terms, their refit at texture_size and its error.
   struct Answer {
     std::vector<Term> ts;
@@ -763,31 +768,25 @@ bool Structured::reseed_keep(std::vector<Term>& ts, double& value, std::vector<R
         chosen.push_back(i);
     }
   for (size_t i : chosen) polish(found[i].ts, found[i].value, 0, 1, n, rec, opt_.powell);
-  bool moved = false;
-  std::vector<Term> best_ts = ts;
-  double best = value;
   size_t pick = found.size();
   for (size_t i : chosen)
     if (found[i].value < value * (1 - 1e-6) && (pick == found.size() || found[i].value < found[pick].value)) pick = i;
-  if (pick < found.size()) {
-    Reseeded& f = found[pick];
-    polish(f.ts, f.value, 0, polish_sweeps_, n, rec, opt_.powell);
-    polish(f.ts, f.value, 0, polish_sweeps_, n, rec, fine);
-    if (f.value < best * (1 - 1e-6)) {
-      best = f.value;
-      best_ts = f.ts;
-      moved = true;
-    }
-  }
-  if (moved) ts = best_ts;
-  return moved;
+  return pick < found.size() && keep_if_lower(found[pick], ts, value, n, fine, rec);
 }
 
-bool Structured::reseed_switch(std::vector<Term>& ts, double& value, int n, const PowellOptions& fine,
+bool Structured::keep_if_lower(Reseeded& f, std::vector<Term>& ts, double& value, int n, const PowellOptions& fine,
                                TermRecord* rec) {
+  polish(f.ts, f.value, 0, polish_sweeps_, n, rec, opt_.powell);
+  polish(f.ts, f.value, 0, polish_sweeps_, n, rec, fine);
+  if (!(f.value < value * (1 - 1e-6))) return false;
+  ts = f.ts;
+  value = f.value;
+  return true;
+}
+
+bool Structured::reseed_switch(std::vector<Term>& ts, const std::vector<FactorTerm>& done, double& value, int n,
+                               const PowellOptions& fine, TermRecord* rec) {
   const size_t J = ts.size();
-  std::vector<FactorTerm> done;
-  if (!std::isfinite(schedule(ts, &done, n))) return false;
   SearchOptions po[2] = {popt_[0], popt_[1]};
   po[0].fit.solve_last = po[1].fit.solve_last = n;
   std::vector<Reseeded> found(J);
@@ -828,14 +827,7 @@ bool Structured::reseed_switch(std::vector<Term>& ts, double& value, int n, cons
     rec->backfit_evaluations += found[i].fits;
     if (found[i].value < value * (1 - 1e-6) && (pick == J || found[i].value < found[pick].value)) pick = i;
   }
-  if (pick == J) return false;
-  Reseeded& f = found[pick];
-  polish(f.ts, f.value, 0, polish_sweeps_, n, rec, opt_.powell);
-  polish(f.ts, f.value, 0, polish_sweeps_, n, rec, fine);
-  if (!(f.value < value * (1 - 1e-6))) return false;
-  ts = f.ts;
-  value = f.value;
-  return true;
+  return pick < J && keep_if_lower(found[pick], ts, value, n, fine, rec);
 }
 
 void Structured::reseed(std::vector<Term>& ts, double& value, TermRecord* rec) {
@@ -843,9 +835,13 @@ void Structured::reseed(std::vector<Term>& ts, double& value, TermRecord* rec) {
   const size_t J = ts.size();
   const int n = static_cast<int>(J);
   std::vector<FactorTerm> done;
-  value = schedule(ts, &done, n);
-  ++evaluations_;
-  ++rec->backfit_evaluations;
+  // The joint fit of ts (its textures are read by the next replacements).
+  const auto refit_done = [&] {
+    value = schedule(ts, &done, n);
+    ++evaluations_;
+    ++rec->backfit_evaluations;
+  };
+  refit_done();
   if (!std::isfinite(value)) return;
   std::vector<std::vector<size_t>> subsets;
   for (size_t i = 0; i < J; ++i) subsets.push_back({i});
@@ -875,12 +871,9 @@ void Structured::reseed(std::vector<Term>& ts, double& value, TermRecord* rec) {
     // (planted mixed member 3, 4 terms: w w w h became h w w h on wrong planes).
     restart_pairs = false;
     for (size_t i = 0; i < ts.size(); ++i) restart_pairs = restart_pairs || ts[i].p != mix[i];
-    value = schedule(ts, &done, n);
-    ++evaluations_;
-    ++rec->backfit_evaluations;
+    refit_done();
   }
-  for (size_t k = 0; k < J && reseed_switch(ts, value, n, fine, rec); ++k) {
-  }
+  for (size_t k = 0; k < J && std::isfinite(value) && reseed_switch(ts, done, value, n, fine, rec); ++k) refit_done();
   rec->seconds += now_seconds() - t0;
 }
 

@@ -76,6 +76,13 @@ SearchResult check_mixed_member(int member, int terms, Parameterization p, doubl
   return r;
 }
 
+// The number of r's terms read through wiwo.
+int wiwo_terms(const SearchResult& r) {
+  int n = 0;
+  for (const FactorTerm& t : r.factorization->terms()) n += t.proj.param == Parameterization::WiWo;
+  return n;
+}
+
 }  // namespace
 
 TEST_CASE("rotation4: from_matrix inverts matrix") {
@@ -413,10 +420,7 @@ TEST_CASE("structured search: re-seeding keeps a replacement that changes the mi
   // replacement over both parameterizations (the wiwo one), so no mix but
   // w w w was ever polished. One replacement per parameterization (the
   // higher one read for a mix no other candidate has): 0.73x.
-  const SearchResult r = check_mixed_member(8, 3, Parameterization::WiWo, 2.0, 0.005);
-  int wiwo = 0;
-  for (const FactorTerm& t : r.factorization->terms()) wiwo += t.proj.param == Parameterization::WiWo;
-  CHECK(wiwo == 2);
+  CHECK(wiwo_terms(check_mixed_member(8, 3, Parameterization::WiWo, 2.0, 0.005)) == 2);
 }
 
 TEST_CASE("structured search: re-seeding moves a term alone to the other parameterization", "[slow]") {
@@ -426,10 +430,7 @@ TEST_CASE("structured search: re-seeding moves a term alone to the other paramet
   // seeds at 0.027-0.030, 5x the objective then, so no round polished it.
   // Powell on that term alone in wiwo from the seed reaches the true wiwo
   // plane (reseed_switch): 0.62x, every plane within 0.001.
-  const SearchResult r = check_mixed_member(7, 3, Parameterization::HalfDiff, 2.0, 0.005);
-  int wiwo = 0;
-  for (const FactorTerm& t : r.factorization->terms()) wiwo += t.proj.param == Parameterization::WiWo;
-  CHECK(wiwo == 1);
+  CHECK(wiwo_terms(check_mixed_member(7, 3, Parameterization::HalfDiff, 2.0, 0.005)) == 1);
 }
 
 TEST_CASE("structured search: McCool's form is inside the search space and survives export") {
