@@ -244,6 +244,12 @@ class Structured {
   // and Powell from that seed reaches the true wiwo plane at 0.0013).
   bool reseed_switch(std::vector<Term>& ts, const std::vector<FactorTerm>& done, double& value, int n,
                      const PowellOptions& fine, TermRecord* rec);
+  // reseed() of the polished answer ts and, again, of the best beam
+  // configuration other than polish_start (the configuration the polish
+  // started from); ts becomes the lower, and value its objective under n
+  // terms solved jointly when it moved.
+  void reseed_answer(std::vector<Term>& ts, double& value, int n, const std::vector<Config>& beam,
+                     const std::vector<Term>& polish_start, TermRecord* rec);
   // A k-term answer: its terms, their refit at texture_size and its error.
   struct Answer {
     std::vector<Term> ts;
@@ -940,6 +946,45 @@ std::vector<Term> Structured::fill_answers(const std::vector<Term>& ts, const st
   return answer_ts;
 }
 
+void Structured::reseed_answer(std::vector<Term>& ts, double& value, int n, const std::vector<Config>& beam,
+                               const std::vector<Term>& polish_start, TermRecord* rec) {
+  const size_t J = ts.size();
+  const std::vector<Term> before = ts;
+  double joint = kInf;
+  reseed(ts, joint, rec);
+  // Re-seeding again from the best beam configuration other than the one
+  // polished before; the one whose refit at texture_size is lower is kept
+  // (the joint objective can rank them the other way: on cayman's 12^4
+  // grid, 3 terms, keeping the lower one raised rel_mse 0.5815 -> 0.5853).
+  // Re-seeding moves one term or one pair at a time, and some answers have
+  // every plane wrong with no such move out (planted mixed members 1 and 6,
+  // 3 terms, wiwo, and member 7, 3 terms, halfdiff, all at seed 2: 18.5x,
+  // 36.5x and 16.5x the joint floor); from the beam's next configuration
+  // they end at 1.20x, 0.65x and 0.74x. It about doubles re-seeding's fits.
+  for (const Config& c : beam) {
+    if (same_terms(c.ts, polish_start)) continue;
+    std::vector<Term> alt = c.ts;
+    double alt_joint = kInf;
+    reseed(alt, alt_joint, rec);
+    if (std::isfinite(alt_joint)) {
+      const Answer a = answer_of(alt), m = answer_of(ts);
+      evaluations_ += 2;
+      if (a.error < m.error) {
+        ts = std::move(alt);
+        joint = alt_joint;
+      }
+    }
+    break;
+  }
+  bool moved = false;
+  for (size_t i = 0; i < J; ++i)
+    moved = moved || ts[i].p != before[i].p || plane_distance(ts[i].R, before[i].R) > 0;
+  if (moved) {
+    value = static_cast<size_t>(n) >= J ? joint : schedule(ts, nullptr, n);
+    ++evaluations_;
+  }
+}
+
 SearchResult Structured::run() {
   const double t0 = now_seconds();
   SearchResult out;
@@ -1016,6 +1061,7 @@ SearchResult Structured::run() {
       value = v;
     }
   }
+  const std::vector<Term> polish_start = ts;
   if (polished) {
     // Under the schedule's objective, re-searching an early term re-solves every
     // later step; only the last solve's terms are polished there.
@@ -1037,18 +1083,7 @@ SearchResult Structured::run() {
   // Searches of 3..kReseedTerms terms with a parameterization per term: the
   // terms re-read under the joint objective (reseed), which finds planes the
   // beam misses when the terms do not share one parameterization.
-  if (reseeded) {
-    const std::vector<Term> before = ts;
-    double joint = kInf;
-    reseed(ts, joint, &records.back());
-    bool moved = false;
-    for (size_t i = 0; i < ts.size(); ++i)
-      moved = moved || ts[i].p != before[i].p || plane_distance(ts[i].R, before[i].R) > 0;
-    if (moved) {
-      value = n >= J ? joint : schedule(ts, nullptr, n);
-      ++evaluations_;
-    }
-  }
+  if (reseeded) reseed_answer(ts, value, n, beam, polish_start, &records.back());
   const std::vector<Term> answer_ts = fill_answers(ts, stage_best, out);
   for (size_t i = 0; i < answer_ts.size(); ++i) records[i].rotation = answer_ts[i].R.packed();
   records.back().search_rel_mse = value;

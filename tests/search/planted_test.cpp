@@ -55,15 +55,18 @@ SearchOptions structured(int terms, int texture) {
 }
 
 // Mixed planted member `member` with `terms` terms (main parameterization p),
-// 16^4 grid, texture 16, seed 1: the structured search ends within `bar`
+// 16^4 grid, texture 16, search seed `seed`: the structured search ends within `bar`
 // times the joint floor with every found plane within `plane_tol` (plane
 // distance) of a true plane of its parameterization.
-SearchResult check_mixed_member(int member, int terms, Parameterization p, double bar, double plane_tol) {
+SearchResult check_mixed_member(int member, int terms, Parameterization p, double bar, double plane_tol,
+                                unsigned seed = 1) {
   const PlantedProductBrdf b = planted_rotation_brdf(member, terms, p);
   const SampleSet s = sample_grid(b, 16);
   const FitData d(s, 1e-5);
   const double fl = joint_floor_error(b, d, 16);
-  SearchResult r = search_factorization(d, structured(terms, 16));
+  SearchOptions opt = structured(terms, 16);
+  opt.seed = seed;
+  SearchResult r = search_factorization(d, opt);
   INFO(b.to_string() << ": joint floor " << fl << ", structured " << r.rel_mse_after_term.back() << " ("
                      << r.evaluations << " fits)");
   CHECK(r.rel_mse_after_term.back() <= bar * fl);
@@ -431,6 +434,16 @@ TEST_CASE("structured search: re-seeding moves a term alone to the other paramet
   // Powell on that term alone in wiwo from the seed reaches the true wiwo
   // plane (reseed_switch): 0.62x, every plane within 0.001.
   CHECK(wiwo_terms(check_mixed_member(7, 3, Parameterization::HalfDiff, 2.0, 0.005)) == 1);
+}
+
+TEST_CASE("structured search: re-seeding also runs from the beam's next configuration", "[slow]") {
+  // Mixed member 6, 3 terms, wiwo main parameterization (w w h), search seed
+  // 2. Re-seeding from the polished best configuration ended at w w w with
+  // every plane 0.98-1.0 from a true one, 36.5x the joint floor, and no
+  // single-term Powell run in either parameterization left it. Re-seeding
+  // again from the beam's next configuration finds all three planes (0.65x;
+  // 38,230 fits against 17,844).
+  CHECK(wiwo_terms(check_mixed_member(6, 3, Parameterization::WiWo, 2.0, 0.005, 2)) == 2);
 }
 
 TEST_CASE("structured search: McCool's form is inside the search space and survives export") {
