@@ -246,8 +246,8 @@ class Structured {
                      const PowellOptions& fine, TermRecord* rec);
   // reseed() of the polished answer ts and, again, of the best beam
   // configuration other than polish_start (the configuration the polish
-  // started from); ts becomes the lower, and value its objective under n
-  // terms solved jointly when it moved.
+  // started from); ts becomes the one whose refit at texture_size is
+  // lower, and value its objective under n terms solved jointly when it moved.
   void reseed_answer(std::vector<Term>& ts, double& value, int n, const std::vector<Config>& beam,
                      const std::vector<Term>& polish_start, TermRecord* rec);
   // A k-term answer: its terms, their refit at texture_size and its error.
@@ -961,9 +961,10 @@ void Structured::reseed_answer(std::vector<Term>& ts, double& value, int n, cons
   // 3 terms, wiwo, and member 7, 3 terms, halfdiff, all at seed 2: 18.5x,
   // 36.5x and 16.5x the joint floor); from the beam's next configuration
   // they end at 1.20x, 0.65x and 0.74x. It about doubles re-seeding's fits.
-  for (const Config& c : beam) {
-    if (same_terms(c.ts, polish_start)) continue;
-    std::vector<Term> alt = c.ts;
+  const auto next = std::find_if(beam.begin(), beam.end(),
+                                 [&](const Config& c) { return !same_terms(c.ts, polish_start); });
+  if (next != beam.end()) {
+    std::vector<Term> alt = next->ts;
     double alt_joint = kInf;
     reseed(alt, alt_joint, rec);
     if (std::isfinite(alt_joint)) {
@@ -974,7 +975,6 @@ void Structured::reseed_answer(std::vector<Term>& ts, double& value, int n, cons
         joint = alt_joint;
       }
     }
-    break;
   }
   bool moved = false;
   for (size_t i = 0; i < J; ++i)

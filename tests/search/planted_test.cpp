@@ -442,7 +442,7 @@ TEST_CASE("structured search: re-seeding also runs from the beam's next configur
   // every plane 0.98-1.0 from a true one, 36.5x the joint floor, and no
   // single-term Powell run in either parameterization left it. Re-seeding
   // again from the beam's next configuration finds all three planes (0.65x;
-  // 38,230 fits against 17,844).
+  // 38,232 fits against 17,844).
   CHECK(wiwo_terms(check_mixed_member(6, 3, Parameterization::WiWo, 2.0, 0.005, 2)) == 2);
 }
 
