@@ -37,6 +37,10 @@ std::string to_string(Parameterization p) {
   return p == Parameterization::WiWo ? "wiwo" : "halfdiff";
 }
 
+Parameterization other_parameterization(Parameterization p) {
+  return p == Parameterization::WiWo ? Parameterization::HalfDiff : Parameterization::WiWo;
+}
+
 namespace {
 // Orthonormal frame (r, s, h) of eq. 1.4.
 void frame_of(const Vec3& h, Vec3& r, Vec3& s) {

@@ -24,6 +24,8 @@ enum class Parameterization { WiWo, HalfDiff };
 // "wiwo" | "halfdiff"; throws std::invalid_argument naming the accepted values otherwise.
 Parameterization parse_parameterization(const std::string& s);
 std::string to_string(Parameterization p);
+// The other one of the two: wiwo <-> halfdiff.
+Parameterization other_parameterization(Parameterization p);
 
 // Half vector and difference vector in the numerically stable form of Kautz-McCool
 // (thesis eq. 1.4): h = normalize(wi + wo); r = normalize(t - (t.h) h) with t = +x

@@ -81,10 +81,6 @@ Mat24 plane(const Rotation4& R, int first_col) {
   P.row(1) = M.col(first_col + 1).transpose();
   return P;
 }
-
-Parameterization other(Parameterization p) {
-  return p == Parameterization::WiWo ? Parameterization::HalfDiff : Parameterization::WiWo;
-}
 }  // namespace
 
 PlantedProductBrdf planted_rotation_brdf(int index, int terms, Parameterization param) {
@@ -99,8 +95,8 @@ PlantedProductBrdf planted_rotation_brdf(int index, int terms, Parameterization 
   ts[1] = {param, plane(R, 2), PlaneFunction::random(rng)};
   if (terms >= 3) {
     const Rotation4 R2 = Rotation4::random(rng);
-    ts.push_back({other(param), plane(R2, 0), PlaneFunction::random(rng)});
-    if (terms == 4) ts.push_back({other(param), plane(R2, 2), PlaneFunction::random(rng)});
+    ts.push_back({other_parameterization(param), plane(R2, 0), PlaneFunction::random(rng)});
+    if (terms == 4) ts.push_back({other_parameterization(param), plane(R2, 2), PlaneFunction::random(rng)});
   }
   const double share = 2.0 / terms;
   for (PlantedTerm& t : ts) scale_to_range(t, share * std::log(10.0) * (1.25 + 0.25 * U(rng)));

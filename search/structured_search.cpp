@@ -810,9 +810,9 @@ bool Structured::reseed_switch(std::vector<Term>& ts, const std::vector<FactorTe
     Reseeded f;
   };
   std::vector<std::vector<Start>> per_term(J);
+  std::vector<int> read_fits(J, 0);  // the refits without term i (refit only)
   parallel_for(J, opt_.threads, [&](size_t i) {
-    const Parameterization other =
-        ts[i].p == Parameterization::WiWo ? Parameterization::HalfDiff : Parameterization::WiWo;
+    const Parameterization other = other_parameterization(ts[i].p);
     std::vector<FactorTerm> others;
     std::vector<Term> rest;
     for (size_t k = 0; k < J; ++k)
@@ -823,10 +823,8 @@ bool Structured::reseed_switch(std::vector<Term>& ts, const std::vector<FactorTe
     std::vector<Start>& starts = per_term[i];
     if (refit) {
       std::vector<FactorTerm> without;
-      const bool ok = std::isfinite(schedule(rest, &without, n - 1));
-      starts.push_back({i, {}});  // carries the refit's fit
-      starts.back().f.fits = 1;
-      if (!ok) return;
+      read_fits[i] = 1;
+      if (!std::isfinite(schedule(rest, &without, n - 1))) return;
       for (const auto& [sp_p, sp] : seeds(residual(without)))
         for (const Rotation4& R : {sp.first, sp.second}) {
           Start st{i, {ts, kInf, 0, true}};
@@ -855,7 +853,6 @@ bool Structured::reseed_switch(std::vector<Term>& ts, const std::vector<FactorTe
   // Powell from every start (in parallel): term i's plane, the others held.
   parallel_for(runs.size(), opt_.threads, [&](size_t q) {
     Reseeded& f = runs[q].f;
-    if (f.ts.empty()) return;
     const size_t i = runs[q].i;
     std::vector<TermSpec> other_specs;
     for (size_t k = 0; k < J; ++k)
@@ -873,6 +870,10 @@ bool Structured::reseed_switch(std::vector<Term>& ts, const std::vector<FactorTe
   // re-read of a right answer (planted mixed member 0, 3 terms, wiwo, seed
   // 2: 0.2%), whose polish and the next pass doubled the search's fits.
   const double below = value * (refit ? 0.99 : 1 - 1e-6);
+  for (const int r : read_fits) {
+    evaluations_ += r;
+    rec->backfit_evaluations += r;
+  }
   size_t pick = runs.size();
   for (size_t q = 0; q < runs.size(); ++q) {
     evaluations_ += runs[q].f.fits;
