@@ -810,7 +810,6 @@ bool Structured::reseed_switch(std::vector<Term>& ts, const std::vector<FactorTe
     Reseeded f;
   };
   std::vector<std::vector<Start>> per_term(J);
-  std::vector<int> read_fits(J, 0);  // the refits without term i (refit only)
   parallel_for(J, opt_.threads, [&](size_t i) {
     const Parameterization other = other_parameterization(ts[i].p);
     std::vector<FactorTerm> others;
@@ -823,7 +822,6 @@ bool Structured::reseed_switch(std::vector<Term>& ts, const std::vector<FactorTe
     std::vector<Start>& starts = per_term[i];
     if (refit) {
       std::vector<FactorTerm> without;
-      read_fits[i] = 1;
       if (!std::isfinite(schedule(rest, &without, n - 1))) return;
       for (const auto& [sp_p, sp] : seeds(residual(without)))
         for (const Rotation4& R : {sp.first, sp.second}) {
@@ -870,9 +868,9 @@ bool Structured::reseed_switch(std::vector<Term>& ts, const std::vector<FactorTe
   // re-read of a right answer (planted mixed member 0, 3 terms, wiwo, seed
   // 2: 0.2%), whose polish and the next pass doubled the search's fits.
   const double below = value * (refit ? 0.99 : 1 - 1e-6);
-  for (const int r : read_fits) {
-    evaluations_ += r;
-    rec->backfit_evaluations += r;
+  if (refit) {  // each term's refit without it
+    evaluations_ += static_cast<int>(J);
+    rec->backfit_evaluations += static_cast<int>(J);
   }
   size_t pick = runs.size();
   for (size_t q = 0; q < runs.size(); ++q) {
