@@ -811,16 +811,11 @@ bool Structured::reseed_switch(std::vector<Term>& ts, const std::vector<FactorTe
   };
   std::vector<std::vector<Start>> per_term(J);
   parallel_for(J, opt_.threads, [&](size_t i) {
-    const Parameterization other = other_parameterization(ts[i].p);
-    std::vector<FactorTerm> others;
-    std::vector<Term> rest;
-    for (size_t k = 0; k < J; ++k)
-      if (k != i) {
-        others.push_back(done[k]);
-        rest.push_back(ts[k]);
-      }
     std::vector<Start>& starts = per_term[i];
-    if (refit) {
+    if (refit) {  // seeds of the residual of the others refit without term i
+      std::vector<Term> rest;
+      for (size_t k = 0; k < J; ++k)
+        if (k != i) rest.push_back(ts[k]);
       std::vector<FactorTerm> without;
       if (!std::isfinite(schedule(rest, &without, n - 1))) return;
       for (const auto& [sp_p, sp] : seeds(residual(without)))
@@ -831,6 +826,12 @@ bool Structured::reseed_switch(std::vector<Term>& ts, const std::vector<FactorTe
         }
       return;
     }
+    // Seeds of the joint fit's residual without term i, in the other
+    // parameterization only.
+    std::vector<FactorTerm> others;
+    for (size_t k = 0; k < J; ++k)
+      if (k != i) others.push_back(done[k]);
+    const Parameterization other = other_parameterization(ts[i].p);
     Start st{i, {}};
     for (const auto& [sp_p, sp] : seeds(residual(others), &other))
       for (const Rotation4& R : {sp.first, sp.second}) {
