@@ -150,7 +150,7 @@ class FitKind final : public HomomorphicKind {
   void read(Reader& r, MethodVariant& m, json& o, uint64_t) const override {
     read_refine_options(r, m, o);
     // texture_size = "cv": the ladder's middle until the choice (finish_refine_options).
-    m.texture_size = take_texture_cv(r, o) ? 16 : read_texture_size(r, m, o, 16, kFitTextureMin, kFitTextureMax);
+    m.texture_size = take_texture_cv(r, o, true) ? 16 : read_texture_size(r, m, o, 16, kFitTextureMin, kFitTextureMax);
     HomomorphicOptions& h = homomorphic_options(m);
     h.param = read_param(r, "parameterization", Parameterization::WiWo);
     h.reciprocity = r.boolean("reciprocity", false);

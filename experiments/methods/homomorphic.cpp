@@ -70,10 +70,18 @@ const KeySpec& refine_key(const std::string& name) {
 
 }  // namespace
 
-bool take_texture_cv(Reader& r, json& o) {
+bool take_texture_cv(Reader& r, json& o, bool auto_ok) {
   const auto it = r.combo().find("texture_size");
-  if (it == r.combo().end() || it->second->value<std::string>() != std::optional<std::string>("cv")) return false;
+  if (it == r.combo().end() || it->second->is_integer()) return false;
+  const std::optional<std::string> s = it->second->value<std::string>();
+  if (auto_ok && s == std::optional<std::string>("auto")) return false;
   r.take("texture_size");
+  if (s != std::optional<std::string>("cv")) {
+    r.fail("texture_size", "expected an integer in " + std::to_string(kFitTextureMin) + ".." +
+                               std::to_string(kFitTextureMax) + (auto_ok ? ", \"auto\" or" : " or") + " \"cv\", " +
+                               found(*it->second));
+    return true;
+  }
   o["texture_size"] = "cv";
   if (r.take("texture_ladder"))
     r.fail("texture_ladder", "texture_ladder applies only with texture_size = \"auto\"; texture_size = \"cv\" "
@@ -83,11 +91,17 @@ bool take_texture_cv(Reader& r, json& o) {
 
 void read_fit_options(Reader& r, FitOptions& f, json& o) {
   f.eps = r.number(fit_key("eps"), f.eps);
+  // smoothing: a number, or "cv" (chosen per run by finish_refine_options).
   bool cv = false;
-  if (r.has("smoothing"))
-    if (const toml::node* n = r.take("smoothing"); n && n->is_string())
-      cv = n->value<std::string>() == std::optional<std::string>("cv");
-  if (!cv) f.smoothing = r.number(fit_key("smoothing"), f.smoothing);
+  const toml::node* sm = r.has("smoothing") ? r.combo().at("smoothing") : nullptr;
+  if (sm && !sm->is_number()) {
+    r.take("smoothing");
+    cv = sm->value<std::string>() == std::optional<std::string>("cv");
+    const KeySpec& k = fit_key("smoothing");
+    if (!cv) r.fail("smoothing", "expected a number in [" + fmt_num(k.lo) + ", " + fmt_num(k.hi) + "] or \"cv\", " + found(*sm));
+  } else {
+    f.smoothing = r.number(fit_key("smoothing"), f.smoothing);
+  }
   f.extrapolation_prior = r.number(fit_key("extrapolation_prior"), f.extrapolation_prior);
   f.subtract_eps = r.boolean(fit_key("subtract_eps"), f.subtract_eps);
   f.clamp_log_range = r.boolean(fit_key("clamp_log_range"), f.clamp_log_range);

@@ -47,8 +47,11 @@ inline const char* const kCvGridKey = "texture_size and smoothing";
 
 // texture_size = "cv": takes the key when its value is the string "cv" and
 // records o["texture_size"] = "cv" (finish_refine_options then sets
-// MethodVariant::cv); false, untouched, otherwise.
-bool take_texture_cv(Reader& r, nlohmann::json& o);
+// MethodVariant::cv). Any other value that is not an integer (nor "auto"
+// where auto_ok) is reported here, naming every accepted form (an integer
+// in 2..1024, "auto" where accepted, "cv"), and taken. False, untouched,
+// for an integer, "auto" where accepted, or no key.
+bool take_texture_cv(Reader& r, nlohmann::json& o, bool auto_ok);
 
 // The fit keys (texture_size with the given default docs, smoothing, eps,
 // subtract_eps, solve_last, solver) and the refinement keys.

@@ -33,7 +33,7 @@ class McCoolKind final : public HomomorphicKind {
   void read(Reader& r, MethodVariant& m, nlohmann::json& o, uint64_t) const override {
     read_refine_options(r, m, o);
     // texture_size = "cv": the ladder's middle until the choice (finish_refine_options).
-    m.texture_size = take_texture_cv(r, o) ? 16 : read_texture_size(r, m, o, 16, kFitTextureMin, kFitTextureMax);
+    m.texture_size = take_texture_cv(r, o, true) ? 16 : read_texture_size(r, m, o, 16, kFitTextureMin, kFitTextureMax);
     m.tolerance = read_tolerance(r, o);
     if (m.tolerance && m.texture_ladder.empty())
       r.fail("tolerance", "kind = \"mccool\" has exactly 2 textures: a tolerance can only choose the resolution "

@@ -339,7 +339,7 @@ class SearchKind final : public HomomorphicKind {
     m.terms = static_cast<int>(r.integer(key("terms"), m.tolerance ? 8 : s.terms));
     if (m.tolerance) m.cap = m.terms;
     // texture_size = "cv": the search runs at the default 16 (SearchCvCache).
-    m.texture_size = take_texture_cv(r, o) ? s.texture_size
+    m.texture_size = take_texture_cv(r, o, false) ? s.texture_size
                                            : static_cast<int>(r.integer("texture_size", s.texture_size, 2, 1024));
     s.search_texture_size = static_cast<int>(r.integer("search_texture_size", 0, 0, 1024));
     if (s.search_texture_size == 1) r.fail("search_texture_size", "expected 0 (same as texture_size) or 2..1024, found 1");

@@ -157,8 +157,12 @@ TEST_CASE("cv: texture_size = cv is rejected where nothing is held out and with 
   require_one_config_error(std::string(kConfigHead) +
                                "[[method]]\nkind = \"mccool\"\ntexture_size = \"cv\"\ntexture_ladder = [4, 8]\n",
                            {"texture_ladder"});
+  // Any other value names every accepted form (the search has no "auto").
   require_one_config_error(std::string(kConfigHead) + "[[method]]\nkind = \"search\"\ntexture_size = \"cvx\"\n",
-                           {"texture_size", "cvx"});
+                           {"texture_size: expected an integer in 2..1024 or \"cv\", found \"cvx\""});
+  for (const char* kind : {"kind = \"mccool\"\n", "kind = \"fit\"\nprojections = [{ name = \"wi\" }, { name = \"wo\" }]\n"})
+    require_one_config_error(std::string(kConfigHead) + "[[method]]\n" + kind + "texture_size = 16.5\n",
+                             {"texture_size: expected an integer in 2..1024, \"auto\" or \"cv\", found 16.5"});
   require_one_config_error(
       std::string(kConfigHead) +
           "[[method]]\nkind = \"search\"\nsmoothing = \"cv\"\ntolerance = { metric = \"rel_mse\", value = 0.1 }\n",

@@ -83,6 +83,9 @@ TEST_CASE("cv: smoothing = cv is rejected where nothing is held out") {
   require_one_config_error(std::string(kConfigHead) +
                                "[[method]]\nkind = \"search\"\nterms = 1\ntexture_size = 4\nsmoothing = \"cv\"\n",
                            {"method.smoothing", "cv", "grid"});
+  // Any other value names both accepted forms and what was found.
   require_one_config_error(std::string(kConfigHead) + "[[method]]\nkind = \"mccool\"\nsmoothing = \"cvx\"\n",
-                           {"smoothing"});
+                           {"smoothing: expected a number in [0, ", "] or \"cv\", found \"cvx\""});
+  require_one_config_error(std::string(kConfigHead) + "[[method]]\nkind = \"search\"\nsmoothing = true\n",
+                           {"smoothing: expected a number in [0, ", "] or \"cv\", found true"});
 }
