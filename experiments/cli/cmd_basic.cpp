@@ -78,7 +78,9 @@ void add_cmd_sample(CLI::App& app) {
   cmd->add_option("--out", *out, "output CSV path")->required();
   cmd->add_option("--grid", *grid, "regular res^4 parabolic grid (e.g. 16)");
   cmd->add_option("--stratified", *count, "number of stratified random pairs");
-  cmd->add_option("--seed", *seed, "seed for --stratified")->capture_default_str();
+  cmd->add_option("--seed", *seed, "seed for --stratified")
+      ->check(non_negative_integer())
+      ->capture_default_str();
   cmd->callback([=] {
     if ((*grid > 0) == (*count > 0))
       throw std::invalid_argument("sample: give exactly one of --grid N or --stratified COUNT");

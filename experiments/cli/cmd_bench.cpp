@@ -5,6 +5,7 @@
 #include <cmath>
 #include <fstream>
 #include <iostream>
+#include <limits>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <random>
@@ -721,7 +722,9 @@ void add_bench_fit(CLI::App* bench) {
   fit->add_option("--parameterization", a->param, "wiwo or halfdiff")->capture_default_str();
   fit->add_flag("--reciprocity", a->reciprocity, "read each texture through the conjugate too");
   fit->add_option("--repeats", a->repeats, "timed repetitions")->capture_default_str();
-  fit->add_option("--seed", a->seed, "seed of the random projections")->capture_default_str();
+  fit->add_option("--seed", a->seed, "seed of the random projections")
+      ->check(non_negative_integer())
+      ->capture_default_str();
   fit->add_option("--solver", a->solver, "auto, dense, sparse or qr")->capture_default_str();
   fit->add_option("--smoothing", a->smoothing, "Laplacian weight")->capture_default_str();
   fit->add_flag("--exact-error", a->exact_error,
@@ -753,7 +756,9 @@ void add_bench_search(CLI::App* bench) {
   search->add_option("--solve-last", b->solve_last, "terms solved jointly (n)")->capture_default_str();
   search->add_option("--parameterization", b->param, "wiwo or halfdiff")->capture_default_str();
   search->add_flag("--reciprocity", b->reciprocity, "read each texture through the conjugate too");
-  search->add_option("--seed", b->seed, "seed of the random starts")->capture_default_str();
+  search->add_option("--seed", b->seed, "seed of the random starts")
+      ->check(non_negative_integer())
+      ->capture_default_str();
   search->add_option("--optimizer", b->optimizer, "powell, praxis, bobyqa, neldermead, sbplx, direct, crs")
       ->capture_default_str();
   search->add_option("--threads", b->threads, "threads for the restarts (0 = all cores)")->capture_default_str();
@@ -816,7 +821,9 @@ void add_bench_lines(CLI::App* bench) {
       ->capture_default_str();
   lines->add_option("--texture", la->texture, "texture resolution of the objective")->capture_default_str();
   lines->add_option("--parameterization", la->param, "wiwo or halfdiff")->capture_default_str();
-  lines->add_option("--seed", la->seed, "seed of the random starts")->capture_default_str();
+  lines->add_option("--seed", la->seed, "seed of the random starts")
+      ->check(non_negative_integer())
+      ->capture_default_str();
   lines->add_option("--line-tol", la->line_tol, "golden-section bracket width (t)")->capture_default_str();
   lines->add_option("--starts", la->starts, "random starting rotations (6 lines each)")->capture_default_str();
   lines->add_option("--presweeps", la->presweeps, "golden Powell sweeps from each start before the lines")
@@ -853,12 +860,25 @@ void add_bench_planted(CLI::App* bench) {
   planted->add_option("--solve-last", pa->solve_last, "terms solved jointly (n), search and floor")->capture_default_str();
   planted->add_option("--beam-width", pa->beam_width, beam_width_help())->capture_default_str();
   planted->add_option("--keep", pa->keep, "structured: Powell runs per step")->capture_default_str();
-  planted->add_option("--seed", pa->seed, "seed of the searches' random starts")->capture_default_str();
+  planted->add_option("--seed", pa->seed, "seed of the searches' random starts")
+      ->check(non_negative_integer())
+      ->capture_default_str();
   planted->add_option("--threads", pa->threads, "threads (0 = all cores)")->capture_default_str();
   planted->add_option("--strategy", pa->strategy, "greedy, structured or both")
       ->check(CLI::IsMember({"structured", "greedy", "both"}))
       ->capture_default_str();
   planted->callback([pa, planted] {
+    // Checked before the table's header is printed, by the option's name.
+    if (pa->first < 0)
+      throw std::invalid_argument("--first: expected a member index >= 0, found " + std::to_string(pa->first));
+    if (pa->count < 1 || pa->count > std::numeric_limits<int>::max() - pa->first)
+      throw std::invalid_argument("--count: expected >= 1 (and --first + --count within an int), found " +
+                                  std::to_string(pa->count));
+    if (pa->grid < 2 || pa->grid > kMaxSampleGridResolution)
+      throw std::invalid_argument("--grid: expected 2.." + std::to_string(kMaxSampleGridResolution) + ", found " +
+                                  std::to_string(pa->grid));
+    if (pa->texture < 2 || pa->texture > 1024)
+      throw std::invalid_argument("--texture: expected 2..1024, found " + std::to_string(pa->texture));
     if (pa->family == "mixed") {
       pa->mixed_terms_given = planted->get_option("--terms")->count() > 0;
       pa->mixed_param_given = planted->get_option("--parameterization")->count() > 0;

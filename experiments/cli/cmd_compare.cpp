@@ -39,7 +39,9 @@ void add_cmd_compare(CLI::App& app) {
       ->required();
   cmd->add_option("--reference", a->reference, "the truth: catalogue name[:k=v,...] or measured file")->required();
   cmd->add_option("--pairs", a->pairs, "direction pairs of the validation design")->capture_default_str();
-  cmd->add_option("--seed", a->seed, "seed of the validation design")->capture_default_str();
+  cmd->add_option("--seed", a->seed, "seed of the validation design")
+      ->check(non_negative_integer())
+      ->capture_default_str();
   cmd->add_option("--eps", a->eps, "log transform's eps (relative to the reference's channel mean)")
       ->capture_default_str();
   cmd->callback([a] {

@@ -50,7 +50,7 @@ void add_cmd_mc_variance(CLI::App& app) {
   cmd->add_option("--environment-eps", a->eps, "band limit of the map: 1 - eps of its energy")->capture_default_str();
   cmd->add_option("--spp", a->spp, "samples per pixel of the variance column")->capture_default_str();
   cmd->add_option("--size", a->size, "pixels per edge")->capture_default_str();
-  cmd->add_option("--seed", a->seed, "seed")->capture_default_str();
+  cmd->add_option("--seed", a->seed, "seed")->check(non_negative_integer())->capture_default_str();
   cmd->add_option("--view-phi-bins", a->view_phi_bins,
                   "view azimuth bins of the tabulated sampler (0: 1 for an isotropic BRDF, else 16; "
                   "1 for a factorization of an isotropic BRDF, as run does)")

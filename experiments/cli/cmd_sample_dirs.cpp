@@ -28,7 +28,9 @@ void add_cmd_sample_dirs(CLI::App& app) {
   cmd->add_option("--brdf", *spec, "catalogue name[:k=v,...], measured file or factors.json")->required();
   cmd->add_option("--wo", *wo, "view direction x,y,z (local frame, normalized)")->required();
   cmd->add_option("-n", *n, "number of samples, 1..1e7")->capture_default_str();
-  cmd->add_option("--seed", *seed, "seed of the uniform numbers (u1, u2)")->capture_default_str();
+  cmd->add_option("--seed", *seed, "seed of the uniform numbers (u1, u2)")
+      ->check(non_negative_integer())
+      ->capture_default_str();
   cmd->add_option("--method", *method, "auto | tabulated | cosine")->capture_default_str();
   cmd->add_option("--view-bins", o->view_bins, "theta_o bins of the table")->capture_default_str();
   cmd->add_option("--theta-bins", o->theta_bins, "theta_i cells of the table")->capture_default_str();

@@ -140,7 +140,9 @@ void add_cmd_stress(CLI::App& app) {
   c->add_option("--res", a->opt.res, "Texture resolution of the homomorphic terms")->capture_default_str();
   c->add_option("--samples", a->opt.samples, "Stratified samples per case")->capture_default_str();
   c->add_option("--svd-res", a->opt.svd_res, "SVD texel grid resolution")->capture_default_str();
-  c->add_option("--seed", a->opt.seed, "Seed of samples and random projections")->capture_default_str();
+  c->add_option("--seed", a->opt.seed, "Seed of samples and random projections")
+      ->check(non_negative_integer())
+      ->capture_default_str();
   c->add_option("--cond-max", a->opt.cond_max_unknowns,
                 "Largest number of unknowns for the dense condition estimate")->capture_default_str();
   c->add_flag("--list", a->list, "List the cases and exit");

@@ -7,6 +7,19 @@
 
 namespace bf {
 
+// The check of every option held in an unsigned type (the seeds): CLI11 2.1
+// converts "-1" to 2^64 - 1 without a word, so anything but decimal digits
+// is refused by the option's name before conversion.
+inline CLI::Validator non_negative_integer() {
+  return CLI::Validator(
+      [](std::string& s) {
+        return !s.empty() && s.find_first_not_of("0123456789") == std::string::npos
+                   ? std::string()
+                   : "expected a non-negative integer, found " + s;
+      },
+      "UINT");
+}
+
 void add_cmd_list(CLI::App& app);    // cmd_basic.cpp
 void add_cmd_eval(CLI::App& app);    // cmd_basic.cpp
 void add_cmd_sample(CLI::App& app);  // cmd_basic.cpp

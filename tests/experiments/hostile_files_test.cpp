@@ -335,7 +335,7 @@ TEST_CASE("hostile configs: names read from a config cannot climb out of the out
   CHECK_FALSE(bf::is_path_inside("runs//x"));
 }
 
-TEST_CASE("hostile options: sizes that would allocate without bound are refused with the bound") {
+TEST_CASE("hostile options: unbounded sizes and negative seeds or members are refused by name") {
   ScratchDir d;
   struct Case {
     std::vector<std::string> args;
@@ -359,6 +359,17 @@ TEST_CASE("hostile options: sizes that would allocate without bound are refused 
       {{"sample", "--brdf", "bluepaint", "--out", d / "s.csv", "--stratified", "100000000"},
        "stratified count: expected 1..10000000"},
       {{"sample", "--brdf", "bluepaint", "--out", d / "s.csv", "--grid", "200"}, "grid resolution: expected 2..64"},
+      // A negative seed is refused by name (CLI11 2.1 alone would wrap it to 2^64 - 1).
+      {{"bench", "search", "--seed", "-1"}, "--seed: expected a non-negative integer, found -1"},
+      {{"bench", "planted", "--seed", "-3"}, "--seed: expected a non-negative integer, found -3"},
+      {{"compare", "--brdf", "bluepaint", "--reference", "bluepaint", "--seed", "-1"},
+       "--seed: expected a non-negative integer, found -1"},
+      {{"sample", "--brdf", "bluepaint", "--out", d / "s.csv", "--stratified", "10", "--seed", "-1"},
+       "--seed: expected a non-negative integer, found -1"},
+      {{"bench", "planted", "--first", "-1"}, "--first: expected a member index >= 0, found -1"},
+      {{"bench", "planted", "--count", "0"}, "--count: expected >= 1"},
+      {{"bench", "planted", "--grid", "1"}, "--grid: expected 2..64, found 1"},
+      {{"bench", "planted", "--texture", "4096"}, "--texture: expected 2..1024, found 4096"},
       {{"run", strat, "--dry-run"}, "sampling.count: expected an integer in 1..10000000, found 100000000"},
       {{"run", grid, "--dry-run"}, "sampling.resolution: expected an integer in 2..64, found"},
   };
@@ -372,6 +383,7 @@ TEST_CASE("hostile options: sizes that would allocate without bound are refused 
     INFO(out);
     CHECK_THAT(out, Contains(c.message));
     CHECK_THAT(out, !Contains("bad_alloc"));
+    CHECK_THAT(out, !Contains("|---|"));  // refused before any table is printed
   }
 }
 
