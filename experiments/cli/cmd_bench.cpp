@@ -464,8 +464,6 @@ struct BenchPlantedArgs {
 // The planted family: per member, McCool's error, the greedy and the
 // structured search, and the floor (fit at the true projections, best order).
 void run_bench_planted(const BenchPlantedArgs& a) {
-  std::fprintf(stderr, "| member | McCool | greedy | structured | floor | greedy/floor | structured/floor | fits greedy | fits structured | s greedy | s structured |\n");
-  std::fprintf(stderr, "|---|---|---|---|---|---|---|---|---|---|---|\n");
   // The members: (index, terms, parameterization); the mixed family is every
   // index at 3 and 4 terms, main parameterization wiwo and halfdiff.
   struct Member {
@@ -481,6 +479,33 @@ void run_bench_planted(const BenchPlantedArgs& a) {
           if ((!a.mixed_terms_given || t == a.terms) && (!a.mixed_param_given || a.param == p))
             members.push_back({i, t, p});
   }
+  const char* names[2] = {"greedy", "structured"};
+  // The search options of member m's strategy k (0 greedy, 1 structured).
+  const auto search_options = [&](const Member& m, int k) {
+    SearchOptions opt;
+    opt.strategy = names[k];
+    // The greedy search reads the planted parameterization (its best case);
+    // the structured one chooses per term.
+    if (a.family != "mccool") opt.param = parse_parameterization(m.param);
+    opt.terms = a.family == "mccool" ? 3 : m.terms;
+    opt.fit.solve_last = a.solve_last;
+    if (k == 1) {
+      opt.beam_width = a.beam_width;
+      opt.keep = a.keep;
+    }
+    opt.texture_size = a.texture;
+    opt.restarts = a.restarts;
+    opt.threads = a.threads;
+    opt.seed = a.seed;
+    return opt;
+  };
+  // Every search's options are checked before the table's header and the
+  // first floor fit, not when that member's search starts.
+  for (const Member& m : members)
+    for (int k = 0; k < 2; ++k)
+      if (a.strategy == "both" || a.strategy == names[k]) search_options(m, k).validate();
+  std::fprintf(stderr, "| member | McCool | greedy | structured | floor | greedy/floor | structured/floor | fits greedy | fits structured | s greedy | s structured |\n");
+  std::fprintf(stderr, "|---|---|---|---|---|---|---|---|---|---|---|\n");
   const bool joint_floor = a.floor == "joint" || a.family == "mixed";
   for (const Member& m : members) {
     const int i = m.index;
@@ -522,25 +547,9 @@ void run_bench_planted(const BenchPlantedArgs& a) {
     j["floor_kind"] = joint_floor ? "joint" : "schedule";
     double err[2] = {NAN, NAN}, secs[2] = {NAN, NAN};
     int fits[2] = {0, 0};
-    const char* names[2] = {"greedy", "structured"};
     for (int k = 0; k < 2; ++k) {
       if (a.strategy != "both" && a.strategy != names[k]) continue;
-      SearchOptions opt;
-      opt.strategy = names[k];
-      // The greedy search reads the planted parameterization (its best case);
-      // the structured one chooses per term.
-      if (a.family != "mccool") opt.param = parse_parameterization(m.param);
-      opt.terms = terms;
-      opt.fit.solve_last = a.solve_last;
-      if (k == 1) {
-        opt.beam_width = a.beam_width;
-        opt.keep = a.keep;
-      }
-      opt.texture_size = a.texture;
-      opt.restarts = a.restarts;
-      opt.threads = a.threads;
-      opt.seed = a.seed;
-      const SearchResult r = search_factorization(d, opt);
+      const SearchResult r = search_factorization(d, search_options(m, k));
       err[k] = r.rel_mse_after_term.back();
       secs[k] = r.seconds;
       fits[k] = r.evaluations;

@@ -370,6 +370,8 @@ TEST_CASE("hostile options: unbounded sizes and negative seeds or members are re
       {{"bench", "planted", "--count", "0"}, "--count: expected >= 1"},
       {{"bench", "planted", "--grid", "1"}, "--grid: expected 2..64, found 1"},
       {{"bench", "planted", "--texture", "4096"}, "--texture: expected 2..1024, found 4096"},
+      // The searches' own options, checked (SearchOptions::validate) before any member's fits.
+      {{"bench", "planted", "--keep", "0"}, "keep: expected >= 1, found 0"},
       {{"run", strat, "--dry-run"}, "sampling.count: expected an integer in 1..10000000, found 100000000"},
       {{"run", grid, "--dry-run"}, "sampling.resolution: expected an integer in 2..64, found"},
   };
