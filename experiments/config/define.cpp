@@ -78,7 +78,15 @@ void apply_define(toml::table& root, const std::string& def, Ctx& ctx) {
     // Too deep to parse safely: taken as a string, like any text that is not TOML.
     if (toml_key_depth_problem("v = " + text, origin).empty()) parsed = toml::parse("v = " + text, origin);
     else parsed.insert_or_assign("v", text);
-  } catch (const toml::parse_error&) {
+  } catch (const toml::parse_error& e) {
+    // Digits TOML cannot hold as an integer (beyond 64 bits) are refused, not read as a string.
+    const size_t digits = (!text.empty() && (text[0] == '+' || text[0] == '-')) ? 1 : 0;
+    if (text.size() > digits && text[digits] != '0' &&
+        text.find_first_not_of("0123456789", digits) == std::string::npos) {
+      ctx.issue(origin, key, "expected an integer in 64 bits (or a quoted string), found " + text + " (" +
+                                 std::string(e.description()) + ")");
+      return;
+    }
     parsed.insert_or_assign("v", text);
   }
   const toml::node& value = *parsed.get("v");

@@ -428,6 +428,13 @@ TEST_CASE("hostile values: eval never prints inf or nan, and number messages say
   const std::string ok = write_text(d / "ok.toml", std::string(kConfigHead) + "[[method]]\nkind = \"svd\"\n");
   CHECK(run_cli("run " + ok + " --dry-run -D method[99999999999].terms=1", &text) == 2);
   CHECK_THAT(text, Contains("expected section.key") && !Contains("stoi"));
+  // A -D integer beyond 64 bits is refused as one, not read as the string "99...9".
+  for (const char* def : {"experiment.seed=99999999999999999999999", "method.terms=-18446744073709551617"}) {
+    INFO(def);
+    CHECK(run_cli("run " + ok + " --dry-run -D " + def, &text) == 2);
+    CHECK_THAT(text, Contains(std::string(def).substr(0, std::string(def).find('='))) &&
+                         Contains("expected an integer in 64 bits") && !Contains("(a string)"));
+  }
 }
 
 TEST_CASE("hostile values: log-space messages tell overflow from an all-zero BRDF") {
