@@ -55,6 +55,28 @@ std::string kind_of(const toml::table& t) {
   return "";
 }
 
+// The value of a -D: TOML if it parses as one, else the text as a string,
+// into parsed["v"]. False (an issue reported) for digits TOML cannot hold.
+bool parse_define_value(const std::string& text, const std::string& key, const std::string& origin, Ctx& ctx,
+                        toml::table& parsed) {
+  try {
+    // Too deep to parse safely: taken as a string, like any text that is not TOML.
+    if (toml_key_depth_problem("v = " + text, origin).empty()) parsed = toml::parse("v = " + text, origin);
+    else parsed.insert_or_assign("v", text);
+  } catch (const toml::parse_error& e) {
+    // Digits TOML cannot hold as an integer (beyond 64 bits) are refused, not read as a string.
+    const size_t digits = (!text.empty() && (text[0] == '+' || text[0] == '-')) ? 1 : 0;
+    if (text.size() > digits && text[digits] != '0' &&
+        text.find_first_not_of("0123456789", digits) == std::string::npos) {
+      ctx.issue(origin, key, "expected an integer in 64 bits (or a quoted string), found " + text + " (" +
+                                 std::string(e.description()) + ")");
+      return false;
+    }
+    parsed.insert_or_assign("v", text);
+  }
+  return true;
+}
+
 }  // namespace
 
 void apply_define(toml::table& root, const std::string& def, Ctx& ctx) {
@@ -72,23 +94,8 @@ void apply_define(toml::table& root, const std::string& def, Ctx& ctx) {
                   join(config_keys("top")) + ")");
     return;
   }
-  // The value: TOML if it parses as one, else the text as a string.
   toml::table parsed;
-  try {
-    // Too deep to parse safely: taken as a string, like any text that is not TOML.
-    if (toml_key_depth_problem("v = " + text, origin).empty()) parsed = toml::parse("v = " + text, origin);
-    else parsed.insert_or_assign("v", text);
-  } catch (const toml::parse_error& e) {
-    // Digits TOML cannot hold as an integer (beyond 64 bits) are refused, not read as a string.
-    const size_t digits = (!text.empty() && (text[0] == '+' || text[0] == '-')) ? 1 : 0;
-    if (text.size() > digits && text[digits] != '0' &&
-        text.find_first_not_of("0123456789", digits) == std::string::npos) {
-      ctx.issue(origin, key, "expected an integer in 64 bits (or a quoted string), found " + text + " (" +
-                                 std::string(e.description()) + ")");
-      return;
-    }
-    parsed.insert_or_assign("v", text);
-  }
+  if (!parse_define_value(text, key, origin, ctx, parsed)) return;
   const toml::node& value = *parsed.get("v");
 
   const PathSeg& top = segs[0];
