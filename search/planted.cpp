@@ -104,6 +104,18 @@ PlantedProductBrdf planted_rotation_brdf(int index, int terms, Parameterization 
                                                std::to_string(terms) + " terms, " + to_string(param) + ")");
 }
 
+PlantedProductBrdf planted_mixed_pair_brdf(int index, Parameterization first) {
+  std::mt19937_64 rng(0x9a1700ull + static_cast<uint64_t>(index) * 7919ull +
+                      (first == Parameterization::HalfDiff ? 1 : 0));
+  std::uniform_real_distribution<double> U(0, 1);
+  const Rotation4 R = Rotation4::random(rng), R2 = Rotation4::random(rng);
+  std::vector<PlantedTerm> ts = {{first, plane(R, 0), PlaneFunction::random(rng)},
+                                 {other_parameterization(first), plane(R2, 0), PlaneFunction::random(rng)}};
+  for (PlantedTerm& t : ts) scale_to_range(t, std::log(10.0) * (1.25 + 0.25 * U(rng)));
+  return PlantedProductBrdf(std::move(ts), "planted-mixed-pair(" + std::to_string(index) + ", " + to_string(first) + " + " +
+                                               to_string(other_parameterization(first)) + ")");
+}
+
 PlantedProductBrdf planted_mccool_brdf(int index) {
   std::mt19937_64 rng(0x3cc001ull + static_cast<uint64_t>(index) * 7919ull);
   const PlaneFunction p = PlaneFunction::random(rng), q = PlaneFunction::random(rng);

@@ -64,6 +64,13 @@ class PlantedProductBrdf final : public Brdf {
 // 10^2.5..10^3. Throws std::invalid_argument for terms other than 2, 3 or 4.
 PlantedProductBrdf planted_rotation_brdf(int index, int terms, Parameterization param);
 
+// Member `index` of the planted pairs across parameterizations: the texture
+// a(plane A of a random rotation) read through `first` times b(plane A of a
+// second random rotation) read through the other parameterization, each
+// scaled as a 2-term member of planted_rotation_brdf. The mixed family's
+// 2-term members (`bench planted --family mixed`).
+PlantedProductBrdf planted_mixed_pair_brdf(int index, Parameterization first);
+
 // A BRDF of exact McCool form p(wi) q(h) p(wo) (random smooth p and q, seeded):
 // p on the wi and wo planes of wiwo, q on the h plane of halfdiff.
 PlantedProductBrdf planted_mccool_brdf(int index);

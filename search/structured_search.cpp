@@ -25,8 +25,10 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 // Searches of up to this many terms (per-term parameterization, final_joint)
 // re-read their terms under the joint objective (Structured::reseed). Its
 // subsets grow as J^2 and each round polishes up to J + 1 configurations, so
-// larger searches (W1's 5 terms) skip it.
+// larger searches (W1's 5 terms) skip it. Searches of 2 terms run only its
+// one-term moves (kReseedRoundsTerms: its rounds and second start from 3).
 constexpr int kReseedTerms = 4;
+constexpr int kReseedRoundsTerms = 3;
 // Re-seeding's pair restarts: random frames per parameterization, and how far
 // above the current objective a pair's replacement may start to get them.
 constexpr int kPairRestarts = 8;
@@ -904,7 +906,10 @@ void Structured::reseed(std::vector<Term>& ts, double& value, TermRecord* rec) {
   fine.initial_step = 0.05;
   fine.ftol = 1e-6;
   bool restart_pairs = true;
-  for (int round = 0; round < 4; ++round) {
+  // 2 terms: no rounds (their one pair is the whole configuration, which the
+  // beam searched); the one-term moves below change the mix.
+  const int rounds = n >= kReseedRoundsTerms ? 4 : 0;
+  for (int round = 0; round < rounds; ++round) {
     std::vector<std::array<double, 2>> pair_read;
     std::vector<Reseeded> found = reseed_replacements(ts, done, value, subsets, n, pair_read);
     if (restart_pairs) reseed_pair_restarts(ts, value, round, subsets, pair_read, n, found);
@@ -1013,9 +1018,10 @@ void Structured::reseed_answer(std::vector<Term>& ts, double& value, int n, cons
   // 3 terms, wiwo, and member 7, 3 terms, halfdiff, all at seed 2: 18.5x,
   // 36.5x and 16.5x the joint floor); from the beam's next configuration
   // they end at 1.20x, 0.65x and 0.74x. It about doubles re-seeding's fits.
+  // (Searches of 3 terms and more: at 2 terms the one-term moves suffice.)
   const auto next = std::find_if(beam.begin(), beam.end(),
                                  [&](const Config& c) { return !same_terms(c.ts, polish_start); });
-  if (next != beam.end()) {
+  if (next != beam.end() && J >= static_cast<size_t>(kReseedRoundsTerms)) {
     std::vector<Term> alt = next->ts;
     double alt_joint = kInf;
     reseed(alt, alt_joint, rec);
@@ -1097,7 +1103,7 @@ SearchResult Structured::run() {
   // A stopping rule may end the search early: its configs were scored with solve_last.
   const int n = J == opt_.terms ? n_final : opt_.fit.solve_last;
   const bool polished = J >= 2 && polish_sweeps_ > 0;
-  const bool reseeded = opt_.reseed && J >= 3 && J <= kReseedTerms && opt_.final_joint && params_.size() > 1;
+  const bool reseeded = opt_.reseed && J >= 2 && J <= kReseedTerms && opt_.final_joint && params_.size() > 1;
   // The polish and re-seeding start from the lower (search objective) of the
   // beam's best and the last stage's best. The latter may be a side
   // configuration (the greedy extension) below every beam configuration;
@@ -1132,9 +1138,12 @@ SearchResult Structured::run() {
       polish(ts, value, 0, polish_sweeps_, n, &records.back(), fine);
     }
   }
-  // Searches of 3..kReseedTerms terms with a parameterization per term: the
+  // Searches of 2..kReseedTerms terms with a parameterization per term: the
   // terms re-read under the joint objective (reseed), which finds planes the
-  // beam misses when the terms do not share one parameterization.
+  // beam misses when the terms do not share one parameterization (at 2 terms
+  // a wiwo and a halfdiff plane: the beam ended at w w or h h, 30-43x the
+  // joint floor, on 4 of 12 planted pairs; W1's 2-term answer went from
+  // h h, 0.01676, to w h, 0.01400).
   if (reseeded) reseed_answer(ts, value, n, beam, polish_start, &records.back());
   const std::vector<Term> answer_ts = fill_answers(ts, stage_best, out);
   for (size_t i = 0; i < answer_ts.size(); ++i) records[i].rotation = answer_ts[i].R.packed();

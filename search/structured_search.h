@@ -30,7 +30,7 @@
 //    polish under that joint objective (the schedule's n = 2 solve cannot
 //    reach McCool's error on a BRDF of exactly McCool's form even at the true
 //    planes).
-//  - re-seeding (searches of 3 or 4 terms, per-term parameterization, with
+//  - re-seeding (searches of 2 to 4 terms, per-term parameterization, with
 //    final_joint): under the joint objective, every term and every pair of
 //    terms is read again from the residual of the others' jointly fitted
 //    textures, in each parameterization separately (alternating seeds and
@@ -40,7 +40,10 @@
 //    2x (a subset's higher replacement only for a mix no other candidate
 //    has), are polished and the lowest kept, rounds until nothing moves. The
 //    beam alone missed planes that do not share a parameterization (a halfdiff
-//    term perturbs the wiwo Hessians and the reverse).
+//    term perturbs the wiwo Hessians and the reverse). Then each term alone
+//    is moved to the other parameterization (Powell from the residual's
+//    seeds, the others held). Searches of 2 terms run only these one-term
+//    moves (a wiwo and a halfdiff plane: the beam ended at w w or h h).
 //  - k-term answers: after term k, every configuration of the beam is refit
 //    at texture_size and the best is stage k's answer; besides the beam, that
 //    answer is extended greedily (its random starts in each parameterization,

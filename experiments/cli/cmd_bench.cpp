@@ -465,7 +465,8 @@ struct BenchPlantedArgs {
 // structured search, and the floor (fit at the true projections, best order).
 void run_bench_planted(const BenchPlantedArgs& a) {
   // The members: (index, terms, parameterization); the mixed family is every
-  // index at 3 and 4 terms, main parameterization wiwo and halfdiff.
+  // index at 2, 3 and 4 terms, main (2 terms: first) parameterization wiwo and
+  // halfdiff.
   struct Member {
     int index, terms;
     std::string param;
@@ -474,7 +475,7 @@ void run_bench_planted(const BenchPlantedArgs& a) {
   for (int i = a.first; i < a.first + a.count; ++i) {
     if (a.family != "mixed") members.push_back({i, a.terms, a.param});
     else
-      for (int t : {3, 4})
+      for (int t : {2, 3, 4})
         for (const char* p : {"wiwo", "halfdiff"})
           if ((!a.mixed_terms_given || t == a.terms) && (!a.mixed_param_given || a.param == p))
             members.push_back({i, t, p});
@@ -509,9 +510,9 @@ void run_bench_planted(const BenchPlantedArgs& a) {
   const bool joint_floor = a.floor == "joint" || a.family == "mixed";
   for (const Member& m : members) {
     const int i = m.index;
-    const PlantedProductBrdf b = a.family == "mccool"
-                                     ? planted_mccool_brdf(i)
-                                     : planted_rotation_brdf(i, m.terms, parse_parameterization(m.param));
+    const PlantedProductBrdf b = a.family == "mccool"                    ? planted_mccool_brdf(i)
+                                 : a.family == "mixed" && m.terms == 2 ? planted_mixed_pair_brdf(i, parse_parameterization(m.param))
+                                                                       : planted_rotation_brdf(i, m.terms, parse_parameterization(m.param));
     const SampleSet s = sample_grid(b, a.grid);
     FitOptions fo;
     fo.solve_last = a.solve_last;
@@ -847,7 +848,7 @@ void add_bench_planted(CLI::App* bench) {
   auto pa = std::make_shared<BenchPlantedArgs>();
   planted->add_option("--family", pa->family,
                       "rotation (random rotation planes), mccool (p(wi) q(h) p(wo), 3 terms) or mixed (each member "
-                      "at 3 and 4 terms, main parameterization wiwo and halfdiff, joint floor)")
+                      "at 2, 3 and 4 terms, main parameterization wiwo and halfdiff (2 terms: one plane in each), joint floor)")
       ->check(CLI::IsMember({"rotation", "mccool", "mixed"}))
       ->capture_default_str();
   planted->add_option("--floor", pa->floor,
@@ -857,7 +858,7 @@ void add_bench_planted(CLI::App* bench) {
       ->capture_default_str();
   planted->add_option("--count", pa->count, "members")->capture_default_str();
   planted->add_option("--first", pa->first, "index of the first member")->capture_default_str();
-  planted->add_option("--terms", pa->terms, "rotation family: 2, 3 or 4 terms; mixed family: run only 3 or 4")
+  planted->add_option("--terms", pa->terms, "rotation family: 2, 3 or 4 terms; mixed family: run only 2, 3 or 4")
       ->capture_default_str();
   planted->add_option("--parameterization", pa->param,
                       "rotation family: wiwo or halfdiff; mixed family: run only this main parameterization")
@@ -891,8 +892,8 @@ void add_bench_planted(CLI::App* bench) {
     if (pa->family == "mixed") {
       pa->mixed_terms_given = planted->get_option("--terms")->count() > 0;
       pa->mixed_param_given = planted->get_option("--parameterization")->count() > 0;
-      if (pa->mixed_terms_given && pa->terms != 3 && pa->terms != 4)
-        throw std::invalid_argument("--terms: the mixed family has members of 3 and 4 terms; found " +
+      if (pa->mixed_terms_given && (pa->terms < 2 || pa->terms > 4))
+        throw std::invalid_argument("--terms: the mixed family has members of 2, 3 and 4 terms; found " +
                                     std::to_string(pa->terms));
     }
     run_bench_planted(*pa);

@@ -255,16 +255,21 @@ TEST_CASE("search parameterization: bench planted --family mixed runs only the t
                   "--restarts 1 --threads 1 --strategy greedy",
                   &out) == 0);
   INFO(out);
-  // One member row (of the family's four variants), the one asked for.
+  // One member row (of the family's six variants), the one asked for.
   std::vector<std::string> rows;
   for (size_t at = out.find("| planted"); at != std::string::npos; at = out.find("| planted", at + 1))
     rows.push_back(out.substr(at, out.find('\n', at) - at));
   REQUIRE(rows.size() == 1);
   CHECK(rows[0].find("3 terms") != std::string::npos);
   CHECK(rows[0].find("halfdiff") != std::string::npos);
-  // The family has 3- and 4-term members only.
+  // The 2-term member is a pair across parameterizations, the given one first.
+  REQUIRE(run_cli("bench planted --family mixed --count 1 --terms 2 --parameterization halfdiff --grid 6 --texture 6 "
+                  "--restarts 1 --threads 1 --strategy greedy",
+                  &out) == 0);
+  CHECK(out.find("| planted-mixed-pair(0, halfdiff + wiwo) |") != std::string::npos);
+  // The family has 2-, 3- and 4-term members only.
   CHECK(run_cli("bench planted --family mixed --count 1 --terms 5 --grid 6 --texture 6", &out) == 2);
-  CHECK(out.find("--terms: the mixed family has members of 3 and 4 terms; found 5") != std::string::npos);
+  CHECK(out.find("--terms: the mixed family has members of 2, 3 and 4 terms; found 5") != std::string::npos);
 }
 
 TEST_CASE("search_samples: 0 and off disable the subsample and bad values are refused naming the key") {
