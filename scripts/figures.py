@@ -42,6 +42,8 @@ JOBS = {
     "w1_mccool": ("run", "experiments/figures-w1-mccool.toml", []),
     "w1_search5": ("bench", ["bench", "search", "--brdf", "bluepaint", "--terms", "5", "--restarts", "6",
                              "--strategy", "both"]),
+    "w1_search2": ("bench", ["bench", "search", "--brdf", "bluepaint", "--terms", "2", "--restarts", "6",
+                             "--strategy", "structured"]),
     "quickstart": ("run", "experiments/quickstart.toml", []),
 }
 
@@ -99,7 +101,11 @@ FIGURES.update({
                          "W1: greedy 2 textures / McCool"),
     "w1_greedy5_ratio": (None, ratio("w1_greedy5_rel_mse", "w1_mccool_rel_mse"), "%.3g", 0.03,
                          "W1: greedy 5 textures / McCool"),
+    "w1_only2_rel_mse": ("w1_search2", bench_line("structured", "rel_mse_after_term", 1), "%.3g", 0.03,
+                         "W1: a structured search of 2 terms (re-seeded), 2 textures"),
 })
+FIGURES["w1_only2_ratio"] = (None, ratio("w1_only2_rel_mse", "w1_mccool_rel_mse"), "%.3g", 0.03,
+                             "W1: 2-term structured search / McCool")
 for method, label in (("mccool", "McCool"), ("search", "search, 2 textures"), ("svd", "linear SVD, rank 2")):
     for column, fmt in (("rel_mse", "%.3g"), ("lin_rmse", "%.3g"), ("cos_rmse", "%.3g"),
                         ("shade_rmse", "%.3g"), ("storage_floats", "%d")):
