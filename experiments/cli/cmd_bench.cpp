@@ -510,9 +510,10 @@ void run_bench_planted(const BenchPlantedArgs& a) {
   const bool joint_floor = a.floor == "joint" || a.family == "mixed";
   for (const Member& m : members) {
     const int i = m.index;
+    const Parameterization mp = parse_parameterization(m.param);
     const PlantedProductBrdf b = a.family == "mccool"                    ? planted_mccool_brdf(i)
-                                 : a.family == "mixed" && m.terms == 2 ? planted_mixed_pair_brdf(i, parse_parameterization(m.param))
-                                                                       : planted_rotation_brdf(i, m.terms, parse_parameterization(m.param));
+                                 : a.family == "mixed" && m.terms == 2 ? planted_mixed_pair_brdf(i, mp)
+                                                                       : planted_rotation_brdf(i, m.terms, mp);
     const SampleSet s = sample_grid(b, a.grid);
     FitOptions fo;
     fo.solve_last = a.solve_last;
