@@ -86,6 +86,30 @@ int wiwo_terms(const SearchResult& r) {
   return n;
 }
 
+// Planted pair `member` (planted_mixed_pair_brdf, `first` first) on a grid^4
+// grid: the 2-term structured search at `texture` ends within `bar` times the
+// joint floor with one wiwo term and every plane within `plane_tol` of a true
+// plane of its parameterization.
+void check_pair(int member, Parameterization first, int grid, int texture, double bar, double plane_tol) {
+  const PlantedProductBrdf b = planted_mixed_pair_brdf(member, first);
+  REQUIRE(b.terms().size() == 2);
+  CHECK(b.terms()[0].param == first);
+  CHECK(b.terms()[1].param == other_parameterization(first));
+  const SampleSet s = sample_grid(b, grid);
+  const FitData d(s, 1e-5);
+  const double fl = joint_floor_error(b, d, texture);
+  const SearchResult r = search_factorization(d, structured(2, texture));
+  INFO(b.to_string() << ": joint floor " << fl << ", structured " << r.rel_mse_after_term.back() << " ("
+                     << r.evaluations << " fits)");
+  CHECK(r.rel_mse_after_term.back() <= bar * fl);
+  REQUIRE(r.factorization->terms().size() == 2);
+  CHECK(wiwo_terms(r) == 1);
+  for (const FactorTerm& t : r.factorization->terms()) {
+    INFO(to_string(t.proj.param) << " term");
+    CHECK(b.nearest_plane_distance(t.proj.param, t.proj.P) < plane_tol);
+  }
+}
+
 }  // namespace
 
 TEST_CASE("rotation4: from_matrix inverts matrix") {
@@ -469,25 +493,7 @@ TEST_CASE("structured search: a 2-term pair across parameterizations finds both 
   // 1.73x the joint floor (the wrong plane 1.6 off), member 3 at 2.48x (1.2
   // off). Re-seeding's one-term move (reseed_switch) takes that term to
   // halfdiff: 0.82x and 0.88x, every plane within 0.003.
-  for (int member : {0, 3}) {
-    const PlantedProductBrdf b = planted_mixed_pair_brdf(member, Parameterization::HalfDiff);
-    REQUIRE(b.terms().size() == 2);
-    CHECK(b.terms()[0].param == Parameterization::HalfDiff);
-    CHECK(b.terms()[1].param == Parameterization::WiWo);
-    const SampleSet s = sample_grid(b, 10);
-    const FitData d(s, 1e-5);
-    const double fl = joint_floor_error(b, d, 8);
-    const SearchResult r = search_factorization(d, structured(2, 8));
-    INFO(b.to_string() << ": joint floor " << fl << ", structured " << r.rel_mse_after_term.back() << " ("
-                       << r.evaluations << " fits)");
-    CHECK(r.rel_mse_after_term.back() <= 1.2 * fl);
-    REQUIRE(r.factorization->terms().size() == 2);
-    CHECK(wiwo_terms(r) == 1);
-    for (const FactorTerm& t : r.factorization->terms()) {
-      INFO(to_string(t.proj.param) << " term");
-      CHECK(b.nearest_plane_distance(t.proj.param, t.proj.P) < 0.01);
-    }
-  }
+  for (int member : {0, 3}) check_pair(member, Parameterization::HalfDiff, 10, 8, 1.2, 0.01);
 }
 
 TEST_CASE("structured search: 2-term pairs across parameterizations end near the joint floor", "[slow]") {
@@ -496,18 +502,8 @@ TEST_CASE("structured search: 2-term pairs across parameterizations end near the
   // "Pairs across parameterizations"), but member 1 with halfdiff first, which
   // ends at 55x with both terms in wiwo (a known miss, not tested here).
   for (int member : {0, 2, 3, 4, 5})
-    for (Parameterization first : {Parameterization::WiWo, Parameterization::HalfDiff}) {
-      const PlantedProductBrdf b = planted_mixed_pair_brdf(member, first);
-      const SampleSet s = sample_grid(b, 16);
-      const FitData d(s, 1e-5);
-      const double fl = joint_floor_error(b, d, 16);
-      const SearchResult r = search_factorization(d, structured(2, 16));
-      INFO(b.to_string() << ": joint floor " << fl << ", structured " << r.rel_mse_after_term.back() << " ("
-                         << r.evaluations << " fits)");
-      CHECK(r.rel_mse_after_term.back() <= 2.0 * fl);
-      CHECK(wiwo_terms(r) == 1);
-      for (const FactorTerm& t : r.factorization->terms()) CHECK(b.nearest_plane_distance(t.proj.param, t.proj.P) < 0.005);
-    }
+    for (Parameterization first : {Parameterization::WiWo, Parameterization::HalfDiff})
+      check_pair(member, first, 16, 16, 2.0, 0.005);
 }
 
 TEST_CASE("structured search: McCool's form is inside the search space and survives export") {
