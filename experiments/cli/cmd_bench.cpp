@@ -464,21 +464,21 @@ struct BenchPlantedArgs {
 // The planted family: per member, McCool's error, the greedy and the
 // structured search, and the floor (fit at the true projections, best order).
 void run_bench_planted(const BenchPlantedArgs& a) {
-  // The members: (index, terms, parameterization); the mixed family is every
-  // index at 2, 3 and 4 terms, main (2 terms: first) parameterization wiwo and
-  // halfdiff.
+  // The members: (index, terms, parameterization); McCool's form has 3 terms;
+  // the mixed family is every index at 2, 3 and 4 terms, main (2 terms:
+  // first) parameterization wiwo and halfdiff.
   struct Member {
     int index, terms;
-    std::string param;
+    Parameterization param;
   };
   std::vector<Member> members;
   for (int i = a.first; i < a.first + a.count; ++i) {
-    if (a.family != "mixed") members.push_back({i, a.terms, a.param});
+    if (a.family != "mixed") members.push_back({i, a.family == "mccool" ? 3 : a.terms, parse_parameterization(a.param)});
     else
       for (int t : {2, 3, 4})
         for (const char* p : {"wiwo", "halfdiff"})
           if ((!a.mixed_terms_given || t == a.terms) && (!a.mixed_param_given || a.param == p))
-            members.push_back({i, t, p});
+            members.push_back({i, t, parse_parameterization(p)});
   }
   const char* names[2] = {"greedy", "structured"};
   // The search options of member m's strategy k (0 greedy, 1 structured).
@@ -487,8 +487,8 @@ void run_bench_planted(const BenchPlantedArgs& a) {
     opt.strategy = names[k];
     // The greedy search reads the planted parameterization (its best case);
     // the structured one chooses per term.
-    if (a.family != "mccool") opt.param = parse_parameterization(m.param);
-    opt.terms = a.family == "mccool" ? 3 : m.terms;
+    if (a.family != "mccool") opt.param = m.param;
+    opt.terms = m.terms;
     opt.fit.solve_last = a.solve_last;
     if (k == 1) {
       opt.beam_width = a.beam_width;
@@ -510,15 +510,14 @@ void run_bench_planted(const BenchPlantedArgs& a) {
   const bool joint_floor = a.floor == "joint" || a.family == "mixed";
   for (const Member& m : members) {
     const int i = m.index;
-    const Parameterization mp = parse_parameterization(m.param);
     const PlantedProductBrdf b = a.family == "mccool"                    ? planted_mccool_brdf(i)
-                                 : a.family == "mixed" && m.terms == 2 ? planted_mixed_pair_brdf(i, mp)
-                                                                       : planted_rotation_brdf(i, m.terms, mp);
+                                 : a.family == "mixed" && m.terms == 2 ? planted_mixed_pair_brdf(i, m.param)
+                                                                       : planted_rotation_brdf(i, m.terms, m.param);
     const SampleSet s = sample_grid(b, a.grid);
     FitOptions fo;
     fo.solve_last = a.solve_last;
     const FitData d(s, fo.eps);
-    const int terms = a.family == "mccool" ? 3 : m.terms;
+    const int terms = m.terms;
     // The floor: fit at the true projections, either every term solved
     // jointly (solve_last = terms) or the schedule's (n = solve_last) in the
     // best term order.
