@@ -200,48 +200,110 @@ double line_minimize(const RotationObjective& f, const Rotation4& start, double 
       f0, opt, best_t);
 }
 
-PowellResult powell_minimize(const RotationObjective& f, const Rotation4& start,
-                             const PowellOptions& opt) {
+namespace {
+
+// A line through several rotations: one LineDirection per rotation (zero for
+// a rotation the line holds).
+using JointDirection = std::vector<LineDirection>;
+
+// The line's point at t; a new point of the search is renormalized, a point
+// the line search only evaluates is not.
+std::vector<Rotation4> joint_at(const JointDirection& dir, const std::vector<Rotation4>& start, double t,
+                                bool normalize) {
+  std::vector<Rotation4> out(start.size());
+  for (size_t i = 0; i < start.size(); ++i) {
+    if (dir[i].is_zero()) {
+      out[i] = start[i];
+      continue;
+    }
+    out[i] = dir[i].at(start[i], t);
+    if (normalize) out[i] = out[i].normalized();
+  }
+  return out;
+}
+
+double joint_line_minimize(const JointRotationObjective& f, const std::vector<Rotation4>& start, double f0,
+                           const JointDirection& dir, const PowellOptions& opt, double* best_t, int* evals) {
+  *best_t = 0.0;
+  if (std::all_of(dir.begin(), dir.end(), [](const LineDirection& d) { return d.is_zero(); })) return f0;
+  return line_minimize_1d(
+      [&](double t) {
+        ++*evals;
+        return f(joint_at(dir, start, t, false));
+      },
+      f0, opt, best_t);
+}
+
+// The net direction of a sweep from p0 to p: D_i = p_i p0_i^-1 for each
+// rotation, all rates scaled by the one factor that makes the fastest advance
+// at 1/2 radian per unit t (LineDirection::from's convention).
+JointDirection net_direction(const std::vector<Rotation4>& p0, const std::vector<Rotation4>& p) {
+  JointDirection d(p.size());
+  double m = 0;
+  for (size_t i = 0; i < p.size(); ++i) {
+    d[i] = LineDirection::unscaled(p[i].compose(p0[i].inverse()).normalized());
+    m = std::max(m, d[i].rate());
+  }
+  if (m < 1e-300) return JointDirection(p.size());
+  for (LineDirection& di : d) {
+    di.logS *= 0.5 / m;
+    di.logT *= 0.5 / m;
+  }
+  return d;
+}
+
+}  // namespace
+
+JointPowellResult powell_minimize_joint(const JointRotationObjective& f, const std::vector<Rotation4>& start,
+                                        const PowellOptions& opt) {
   opt.validate();
-  PowellResult res;
-  std::vector<LineDirection> dirs;
-  for (const Rotation4& d : cole_basis_directions()) dirs.push_back(LineDirection::from(d));
-  Rotation4 p = start.normalized();
+  if (start.empty()) throw std::invalid_argument("powell_minimize_joint: expected at least one rotation, found 0");
+  const size_t J = start.size();
+  JointPowellResult res;
+  std::vector<JointDirection> dirs;
+  for (size_t i = 0; i < J; ++i)
+    for (const Rotation4& d : cole_basis_directions()) {
+      JointDirection dir(J);
+      dir[i] = LineDirection::from(d);
+      dirs.push_back(std::move(dir));
+    }
+  std::vector<Rotation4> p(J);
+  for (size_t i = 0; i < J; ++i) p[i] = start[i].normalized();
   double fp = f(p);
   res.evaluations = 1;
   for (int sweep = 0; sweep < opt.max_sweeps && res.evaluations < opt.max_evaluations; ++sweep) {
     res.sweeps = sweep + 1;
-    const Rotation4 p0 = p;
+    const std::vector<Rotation4> p0 = p;
     const double f0 = fp;
     int ibig = 0;
     double del = 0.0;
     for (size_t i = 0; i < dirs.size(); ++i) {
       double t;
-      const double fnew = line_minimize(f, p, fp, dirs[i], opt, &t, &res.evaluations);
+      const double fnew = joint_line_minimize(f, p, fp, dirs[i], opt, &t, &res.evaluations);
       if (fp - fnew > del) {
         del = fp - fnew;
         ibig = static_cast<int>(i);
       }
       if (fnew < fp) {
-        p = dirs[i].at(p, t).normalized();
+        p = joint_at(dirs[i], p, t, true);
         fp = fnew;
       }
     }
     if (2.0 * (f0 - fp) <= opt.ftol * (std::abs(f0) + std::abs(fp)) + 1e-20) break;
     // Net direction of the sweep, D = R_f R_s^-1, and the extrapolated point D R_f.
-    const Rotation4 D = p.compose(p0.inverse()).normalized();
-    const Rotation4 pe = D.compose(p).normalized();
+    std::vector<Rotation4> pe(J);
+    for (size_t i = 0; i < J; ++i) pe[i] = p[i].compose(p0[i].inverse()).normalized().compose(p[i]).normalized();
     const double fe = f(pe);
     ++res.evaluations;
     if (fe < f0) {
       const double tt = 2.0 * (f0 - 2.0 * fp + fe) * std::pow(f0 - fp - del, 2) -
                         del * std::pow(f0 - fe, 2);
       if (tt < 0.0) {
-        const LineDirection nd = LineDirection::from(D);
+        const JointDirection nd = net_direction(p0, p);
         double t;
-        const double fnew = line_minimize(f, p, fp, nd, opt, &t, &res.evaluations);
+        const double fnew = joint_line_minimize(f, p, fp, nd, opt, &t, &res.evaluations);
         if (fnew < fp) {
-          p = nd.at(p, t).normalized();
+          p = joint_at(nd, p, t, true);
           fp = fnew;
         }
         dirs[ibig] = dirs.back();
@@ -251,6 +313,17 @@ PowellResult powell_minimize(const RotationObjective& f, const Rotation4& start,
   }
   res.best = p;
   res.value = fp;
+  return res;
+}
+
+PowellResult powell_minimize(const RotationObjective& f, const Rotation4& start, const PowellOptions& opt) {
+  const JointPowellResult r =
+      powell_minimize_joint([&](const std::vector<Rotation4>& R) { return f(R[0]); }, {start}, opt);
+  PowellResult res;
+  res.best = r.best[0];
+  res.value = r.value;
+  res.evaluations = r.evaluations;
+  res.sweeps = r.sweeps;
   return res;
 }
 

@@ -6,6 +6,7 @@
 
 #include <functional>
 #include <string>
+#include <vector>
 
 #include "search/rotation4.h"
 
@@ -51,6 +52,21 @@ struct PowellResult {
 // Minimizes f from start. Never returns a point worse than start.
 PowellResult powell_minimize(const RotationObjective& f, const Rotation4& start,
                              const PowellOptions& opt);
+
+// The same search over several rotations at once (f of all of them): Cole's
+// six directions for each rotation in turn, the others held, and the sweep's
+// net direction moving all of them together (each rotation's part scaled by
+// one common factor, so the line passes through the sweep's end point). With
+// one rotation it is powell_minimize, step for step.
+using JointRotationObjective = std::function<double(const std::vector<Rotation4>&)>;
+struct JointPowellResult {
+  std::vector<Rotation4> best;
+  double value = 0;
+  int evaluations = 0;
+  int sweeps = 0;
+};
+JointPowellResult powell_minimize_joint(const JointRotationObjective& f, const std::vector<Rotation4>& start,
+                                        const PowellOptions& opt);
 
 // The line search on a function of t alone: g(0) = f0 is known, g is
 // evaluated elsewhere as needed (the caller counts). Bracketing from

@@ -79,7 +79,7 @@ std::array<double, 8> Rotation4::packed() const {
   return {S[0], S[1], S[2], S[3], T[0], T[1], T[2], T[3]};
 }
 
-LineDirection LineDirection::from(const Rotation4& D) {
+LineDirection LineDirection::unscaled(const Rotation4& D) {
   LineDirection d;
   // Pick signs so both angles are in [0, pi/2] (shortest arcs); (S, T) ~ (-S, -T)
   // allows flipping both together only, so flip the pair if S.w < 0, then T's
@@ -91,7 +91,12 @@ LineDirection LineDirection::from(const Rotation4& D) {
   }
   d.logS = qlog(R.S);
   d.logT = qlog(R.T);
-  const double m = std::max(d.logS.norm(), d.logT.norm());
+  return d;
+}
+
+LineDirection LineDirection::from(const Rotation4& D) {
+  LineDirection d = unscaled(D);
+  const double m = d.rate();
   if (m < 1e-300) return LineDirection{};
   d.logS *= 0.5 / m;
   d.logT *= 0.5 / m;

@@ -9,6 +9,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <random>
 
 #include "factor/projection.h"
@@ -72,6 +73,11 @@ struct Rotation4 {
 struct LineDirection {
   Quat logS = Quat::Zero(), logT = Quat::Zero();  // pure quaternions (rates)
   static LineDirection from(const Rotation4& D);
+  // D's logs without the rescaling (shortest-arc signs as in from()); a
+  // direction over several rotations at once scales all of them by one factor.
+  static LineDirection unscaled(const Rotation4& D);
+  // The larger of the two rates' norms.
+  double rate() const { return std::max(logS.norm(), logT.norm()); }
   // D^t applied to the start: (exp(t logS) S_s, T_s exp(t logT)).
   Rotation4 at(const Rotation4& start, double t) const;
   bool is_zero() const { return logS.squaredNorm() + logT.squaredNorm() == 0.0; }

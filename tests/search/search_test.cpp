@@ -67,6 +67,42 @@ SearchOptions small_search(int terms, int restarts) {
 }
 }  // namespace
 
+TEST_CASE("powell: the joint search finds two rotations of a coupled objective") {
+  // f(R1, R2) = d(R1, A) + d(R2, B) + d(R2 R1, B A), its minimum 0 at (A, B)
+  // only: the third part couples the rotations, so holding one while the
+  // other moves is not the whole search.
+  std::mt19937_64 rng(21);
+  const Rotation4 A = Rotation4::random(rng), B = Rotation4::random(rng);
+  const RotationObjective da = projection_distance(A), db = projection_distance(B),
+                          dba = projection_distance(B.compose(A));
+  const JointRotationObjective f = [&](const std::vector<Rotation4>& R) {
+    return da(R[0]) + db(R[1]) + dba(R[1].compose(R[0]));
+  };
+  const std::vector<Rotation4> start{Rotation4::identity(), Rotation4::identity()};
+  for (const auto ls : {PowellOptions::LineSearch::Golden, PowellOptions::LineSearch::Brent}) {
+    PowellOptions opt;
+    opt.ftol = 1e-10;
+    opt.line_tol = 1e-6;
+    opt.line_search = ls;
+    opt.max_evaluations = 20000;
+    const JointPowellResult res = powell_minimize_joint(f, start, opt);
+    INFO(to_string(ls) << ": value " << res.value << " after " << res.evaluations << " evaluations");
+    REQUIRE(res.best.size() == 2);
+    CHECK(res.value < 1e-6);
+    CHECK(res.value <= f(start));
+    CHECK(res.value == Approx(f(res.best)).margin(1e-12));
+  }
+  // One rotation: powell_minimize is this search with J = 1.
+  const RotationObjective g = projection_distance(A);
+  PowellOptions opt;
+  const PowellResult one = powell_minimize(g, Rotation4::identity(), opt);
+  const JointPowellResult joint =
+      powell_minimize_joint([&](const std::vector<Rotation4>& R) { return g(R[0]); }, {Rotation4::identity()}, opt);
+  CHECK(one.value == joint.value);
+  CHECK(one.evaluations == joint.evaluations);
+  CHECK_THROWS_WITH(powell_minimize_joint(f, {}, opt), Catch::Contains("expected at least one rotation"));
+}
+
 TEST_CASE("powell: finds the minimum of a smooth function of the rotation") {
   std::mt19937_64 rng(9);
   const RotationObjective f = projection_distance(Rotation4::random(rng));
