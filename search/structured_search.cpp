@@ -26,7 +26,8 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 // re-read their terms under the joint objective (Structured::reseed). Its
 // subsets grow as J^2 and each round polishes up to J + 1 configurations, so
 // larger searches (W1's 5 terms) skip it. Searches of 2 terms run only its
-// one-term moves (kReseedRoundsTerms: its rounds and second start from 3).
+// one-term moves and the mixed pair's random restarts (kReseedRoundsTerms:
+// its rounds and second start from 3).
 constexpr int kReseedTerms = 4;
 constexpr int kReseedRoundsTerms = 3;
 // Re-seeding's pair restarts: random frames per parameterization, and how far
@@ -255,6 +256,17 @@ class Structured {
   // the halfdiff term in halfdiff: 12.0x -> 0.67x).
   bool reseed_switch(std::vector<Term>& ts, const std::vector<FactorTerm>& done, double& value, int n,
                      const PowellOptions& fine, TermRecord* rec, bool refit);
+  // Two terms, after the one-term moves: kPairRestarts random pairs of
+  // rotations, the first term in wiwo and the second in halfdiff, each
+  // searched by Powell on both rotations at once (powell_minimize_joint)
+  // under the joint objective. The lowest, if below value, gets the full
+  // polish and is kept if it stays lower; true (ts, value updated) then.
+  // A one-term move cannot leave an answer whose two planes are both wrong:
+  // planted mixed pair member 1 (halfdiff first, 16^4 grid) ended at w w,
+  // 55-64x the joint floor, at search seeds 1-3, and member 6 (wiwo first,
+  // seed 2) at w h on two wrong planes, 21x; 3 and 5 of the 8 random pairs
+  // reach the true planes (0.80x and 0.81x).
+  bool reseed_mixed_pair(std::vector<Term>& ts, double& value, int n, const PowellOptions& fine, TermRecord* rec);
   // reseed() of the polished answer ts and, again, of the best beam
   // configuration other than polish_start (the configuration the polish
   // started from); ts becomes the one whose refit at texture_size is
@@ -884,6 +896,29 @@ bool Structured::reseed_switch(std::vector<Term>& ts, const std::vector<FactorTe
   return pick < runs.size() && keep_if_lower(runs[pick].f, ts, value, n, fine, rec);
 }
 
+bool Structured::reseed_mixed_pair(std::vector<Term>& ts, double& value, int n, const PowellOptions& fine,
+                                   TermRecord* rec) {
+  std::mt19937_64 rng(opt_.seed * 1000003ull + 0x9a21ull);
+  std::vector<std::vector<Rotation4>> starts;
+  for (int r = 0; r < kPairRestarts; ++r) starts.push_back({Rotation4::random(rng), Rotation4::random(rng)});
+  const auto with = [&](const std::vector<Rotation4>& R) {
+    return std::vector<Term>{Term{R[0].normalized(), params_[0]}, Term{R[1].normalized(), params_[1]}};
+  };
+  std::vector<Reseeded> runs(starts.size());
+  parallel_for(starts.size(), opt_.threads, [&](size_t q) {
+    const JointPowellResult r = powell_minimize_joint(
+        [&](const std::vector<Rotation4>& R) { return schedule(with(R), nullptr, n); }, starts[q], opt_.powell);
+    runs[q] = Reseeded{with(r.best), r.value, r.evaluations};
+  });
+  size_t pick = runs.size();
+  for (size_t q = 0; q < runs.size(); ++q) {
+    evaluations_ += runs[q].fits;
+    rec->backfit_evaluations += runs[q].fits;
+    if (runs[q].value < value * (1 - 1e-6) && (pick == runs.size() || runs[q].value < runs[pick].value)) pick = q;
+  }
+  return pick < runs.size() && keep_if_lower(runs[pick], ts, value, n, fine, rec);
+}
+
 void Structured::reseed(std::vector<Term>& ts, double& value, TermRecord* rec) {
   const double t0 = now_seconds();
   const size_t J = ts.size();
@@ -907,7 +942,8 @@ void Structured::reseed(std::vector<Term>& ts, double& value, TermRecord* rec) {
   fine.ftol = 1e-6;
   bool restart_pairs = true;
   // 2 terms: no rounds (their one pair is the whole configuration, which the
-  // beam searched); the one-term moves below change the mix.
+  // beam searched); the one-term moves and the mixed pair's restarts below
+  // change the mix.
   const int rounds = n >= kReseedRoundsTerms ? 4 : 0;
   for (int round = 0; round < rounds; ++round) {
     std::vector<std::array<double, 2>> pair_read;
@@ -937,6 +973,9 @@ void Structured::reseed(std::vector<Term>& ts, double& value, TermRecord* rec) {
       break;
     refit_done();
   }
+  // Two terms: random pairs with one term in each parameterization.
+  if (J == 2 && params_.size() > 1 && std::isfinite(value) && reseed_mixed_pair(ts, value, n, fine, rec))
+    refit_done();
   rec->seconds += now_seconds() - t0;
 }
 

@@ -43,7 +43,9 @@
 //    term perturbs the wiwo Hessians and the reverse). Then each term alone
 //    is moved to the other parameterization (Powell from the residual's
 //    seeds, the others held). Searches of 2 terms run only these one-term
-//    moves (a wiwo and a halfdiff plane: the beam ended at w w or h h).
+//    moves (a wiwo and a halfdiff plane: the beam ended at w w or h h) and
+//    then random restarts of a wiwo and a halfdiff term together (Powell on
+//    both rotations at once), which leave an answer with both planes wrong.
 //  - k-term answers: after term k, every configuration of the beam is refit
 //    at texture_size and the best is stage k's answer; besides the beam, that
 //    answer is extended greedily (its random starts in each parameterization,
@@ -64,5 +66,12 @@
 namespace bf {
 
 SearchResult structured_search(const FitData& data, const SearchOptions& opt);
+
+// The structured search's revision: raised whenever a change moves its
+// answers for the same options. Every non-greedy search run carries it in
+// its run id (experiments/methods/search.cpp), so a cached answer of an
+// older revision is recomputed instead of reused. 2: 2-term searches run
+// the mixed pair's random restarts (2026-11-28).
+constexpr int kStructuredSearchRevision = 2;
 
 }  // namespace bf
