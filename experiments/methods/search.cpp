@@ -10,6 +10,7 @@
 #include "experiments/methods/homomorphic.h"
 #include "factor/size_select.h"
 #include "search/rotation4.h"
+#include "search/structured_search.h"
 #include "search/term_search.h"
 #include "solvers/parallel.h"
 
@@ -243,6 +244,7 @@ void record_options(const MethodVariant& m, json& o) {
     o["final_joint"] = s.final_joint;
     o["joint_polish_terms"] = s.joint_polish_terms;
     o["reseed"] = s.reseed;
+    o["structured_revision"] = kStructuredSearchRevision;
   }
   if (s.beam != 1) o["beam"] = s.beam;
   if (s.backfit_sweeps != 0) o["backfit_sweeps"] = s.backfit_sweeps;

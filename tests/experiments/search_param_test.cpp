@@ -10,6 +10,7 @@
 #include "experiments/report/outputs.h"
 #include "experiments_helpers.h"
 #include "factor/export.h"
+#include "search/structured_search.h"
 
 using namespace bf;
 using namespace bf_test;
@@ -161,6 +162,25 @@ TEST_CASE("search options: beam_width and polish_sweeps default by the search si
   CHECK(plan.methods[1].options["beam_width"] == 8);
   CHECK(plan.methods[2].options["polish_sweeps"] == 2);
   CHECK(plan.methods[0].options.dump() != plan.methods[1].options.dump());
+}
+
+TEST_CASE("search options: a non-greedy search's run id holds the structured search's revision") {
+  // A change that moves the structured search's answers raises the revision,
+  // so a run cached by an older search is recomputed (runner: a cached run is
+  // found by its id). Greedy runs keep their ids: the thesis's search has not
+  // changed.
+  register_loaders();
+  const Plan plan = parse_plan(std::string(kConfigHead) +
+                                   "[[method]]\nkind = \"search\"\nterms = 2\n"
+                                   "[[method]]\nkind = \"search\"\nterms = 2\nstrategy = \"best\"\n"
+                                   "[[method]]\nkind = \"search\"\nterms = 2\nstrategy = \"greedy\"\n",
+                               "cfg.toml");
+  REQUIRE(plan.methods.size() == 3);
+  CHECK(plan.methods[0].options.value("structured_revision", -1) == kStructuredSearchRevision);
+  CHECK(plan.methods[1].options.value("structured_revision", -1) == kStructuredSearchRevision);
+  CHECK_FALSE(plan.methods[2].options.contains("structured_revision"));
+  REQUIRE(plan.runs.size() == 3);
+  CHECK(plan.runs[0].identity.at("method").value("structured_revision", -1) == kStructuredSearchRevision);
 }
 
 TEST_CASE("search parameterization: term_param either with an explicit parameterization is refused, naming both keys") {
