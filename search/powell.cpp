@@ -187,19 +187,6 @@ double line_minimize_1d(const LineFunction& g, double f0, const PowellOptions& o
   return bv;
 }
 
-double line_minimize(const RotationObjective& f, const Rotation4& start, double f0,
-                     const LineDirection& dir, const PowellOptions& opt, double* best_t,
-                     int* evals) {
-  *best_t = 0.0;
-  if (dir.is_zero()) return f0;
-  return line_minimize_1d(
-      [&](double t) {
-        ++*evals;
-        return f(dir.at(start, t));
-      },
-      f0, opt, best_t);
-}
-
 namespace {
 
 // A line through several rotations: one LineDirection per rotation (zero for
@@ -234,17 +221,17 @@ double joint_line_minimize(const JointRotationObjective& f, const std::vector<Ro
       f0, opt, best_t);
 }
 
-// The net direction of a sweep from p0 to p: D_i = p_i p0_i^-1 for each
-// rotation, all rates scaled by the one factor that makes the fastest advance
-// at 1/2 radian per unit t (LineDirection::from's convention).
-JointDirection net_direction(const std::vector<Rotation4>& p0, const std::vector<Rotation4>& p) {
-  JointDirection d(p.size());
+// The net direction of a sweep, D_i = p_i p0_i^-1 for each rotation, as a
+// line: all rates scaled by the one factor that makes the fastest advance at
+// 1/2 radian per unit t (LineDirection::from's convention).
+JointDirection net_direction(const std::vector<Rotation4>& D) {
+  JointDirection d(D.size());
   double m = 0;
-  for (size_t i = 0; i < p.size(); ++i) {
-    d[i] = LineDirection::unscaled(p[i].compose(p0[i].inverse()).normalized());
+  for (size_t i = 0; i < D.size(); ++i) {
+    d[i] = LineDirection::unscaled(D[i]);
     m = std::max(m, d[i].rate());
   }
-  if (m < 1e-300) return JointDirection(p.size());
+  if (m < 1e-300) return JointDirection(D.size());
   for (LineDirection& di : d) {
     di.logS *= 0.5 / m;
     di.logT *= 0.5 / m;
@@ -253,6 +240,13 @@ JointDirection net_direction(const std::vector<Rotation4>& p0, const std::vector
 }
 
 }  // namespace
+
+double line_minimize(const RotationObjective& f, const Rotation4& start, double f0,
+                     const LineDirection& dir, const PowellOptions& opt, double* best_t,
+                     int* evals) {
+  return joint_line_minimize([&](const std::vector<Rotation4>& R) { return f(R[0]); }, {start}, f0, {dir}, opt,
+                             best_t, evals);
+}
 
 JointPowellResult powell_minimize_joint(const JointRotationObjective& f, const std::vector<Rotation4>& start,
                                         const PowellOptions& opt) {
@@ -291,15 +285,18 @@ JointPowellResult powell_minimize_joint(const JointRotationObjective& f, const s
     }
     if (2.0 * (f0 - fp) <= opt.ftol * (std::abs(f0) + std::abs(fp)) + 1e-20) break;
     // Net direction of the sweep, D = R_f R_s^-1, and the extrapolated point D R_f.
-    std::vector<Rotation4> pe(J);
-    for (size_t i = 0; i < J; ++i) pe[i] = p[i].compose(p0[i].inverse()).normalized().compose(p[i]).normalized();
+    std::vector<Rotation4> D(J), pe(J);
+    for (size_t i = 0; i < J; ++i) {
+      D[i] = p[i].compose(p0[i].inverse()).normalized();
+      pe[i] = D[i].compose(p[i]).normalized();
+    }
     const double fe = f(pe);
     ++res.evaluations;
     if (fe < f0) {
       const double tt = 2.0 * (f0 - 2.0 * fp + fe) * std::pow(f0 - fp - del, 2) -
                         del * std::pow(f0 - fe, 2);
       if (tt < 0.0) {
-        const JointDirection nd = net_direction(p0, p);
+        const JointDirection nd = net_direction(D);
         double t;
         const double fnew = joint_line_minimize(f, p, fp, nd, opt, &t, &res.evaluations);
         if (fnew < fp) {
