@@ -71,7 +71,8 @@ SearchResult structured_search(const FitData& data, const SearchOptions& opt);
 // answers for the same options. Every non-greedy search run carries it in
 // its run id (experiments/methods/search.cpp), so a cached answer of an
 // older revision is recomputed instead of reused. 2: 2-term searches run
-// the mixed pair's random restarts (2026-11-28).
-constexpr int kStructuredSearchRevision = 2;
+// the mixed pair's random restarts (2026-11-28). 3: those restarts search
+// at half the texture (2026-11-29).
+constexpr int kStructuredSearchRevision = 3;
 
 }  // namespace bf

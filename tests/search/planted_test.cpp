@@ -497,6 +497,10 @@ TEST_CASE("structured search: a 2-term pair across parameterizations finds both 
   // and 0.83 off), which no one-term move leaves; the mixed pair's random
   // restarts (reseed_mixed_pair) reach both true planes: 0.60x, within 0.001.
   for (int member : {0, 1, 3}) check_pair(member, Parameterization::HalfDiff, 10, 8, 1.2, 0.01);
+  // At texture 12 those restarts search at texture 8 (half the search's,
+  // kPairRestartMinTexture) and the pair they keep is read and polished at
+  // 12: member 1 ends at 0.90x (14.7x, both terms in wiwo, without them).
+  check_pair(1, Parameterization::HalfDiff, 10, 12, 1.2, 0.01);
 }
 
 TEST_CASE("structured search: 2-term pairs across parameterizations end near the joint floor", "[slow]") {
