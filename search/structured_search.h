@@ -72,7 +72,8 @@ SearchResult structured_search(const FitData& data, const SearchOptions& opt);
 // its run id (experiments/methods/search.cpp), so a cached answer of an
 // older revision is recomputed instead of reused. 2: 2-term searches run
 // the mixed pair's random restarts (2026-11-28). 3: those restarts search
-// at half the texture (2026-11-29).
+// at half the texture, and also in the answer's mix when its two terms
+// share a parameterization (2026-11-29).
 constexpr int kStructuredSearchRevision = 3;
 
 }  // namespace bf
