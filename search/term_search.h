@@ -82,10 +82,11 @@ struct SearchOptions {
   int joint_polish_terms = 3;
   // Structured, terms 2..4, term_param "either", final_joint: re-read the terms
   // under the joint objective after the polish (structured_search.h,
-  // "re-seeding", with pair restarts from 3 terms; at 2 terms only the
-  // one-term moves); finds planes that do not share a parameterization, at
-  // up to about 3.5x the fits (planted 3-term members: 10,000-15,000 ->
-  // 19,000-25,000; planted 2-term pairs and W1 at 2 terms 2-3x).
+  // "re-seeding", with pair restarts from 3 terms; at 2 terms the one-term
+  // moves and random restarts of both terms at once); finds planes that do
+  // not share a parameterization, at up to about 3.5x the fits (planted
+  // 3-term members: 10,000-15,000 -> 19,000-25,000; planted 2-term pairs
+  // 2-3x, W1 at 2 terms 4,797 -> 19,278).
   bool reseed = true;
   int texture_size = 16;                // final texture resolution
   int search_texture_size = 0;          // resolution during the search; 0 = texture_size

@@ -149,9 +149,9 @@ const std::vector<KeySpec>& search_keys() {
         bool_key("final_joint", "true", "structured: the final refit solves all terms jointly"),
         bool_key("reseed", "true",
                  "structured, 2-4 terms, `term_param = \"either\"`: re-read every term (3-4 terms: and pair of terms; 2 "
-                 "terms: and 8 random starts of a wiwo and a halfdiff term together) under the joint fit after the polish "
-                 "(finds planes of different parameterizations; up to ~5x the fits on planted mixtures, about 2x on W1's "
-                 "2-term search)"),
+                 "terms: and 8 random starts of a wiwo and a halfdiff term together, 8 more in the answer's mix when "
+                 "its terms share one) under the joint fit after the polish (finds planes of different "
+                 "parameterizations; up to ~5x the fits on planted mixtures, about 4x on W1's 2-term search)"),
         int_key("joint_polish_terms", 0, 64, "3",
                 "structured: searches of up to this many terms pick their last term and polish under the joint fit"),
         other_key("search_samples", "0, `\"off\"` or an integer >= 1000", "100000",
