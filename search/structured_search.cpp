@@ -33,12 +33,12 @@ constexpr int kReseedRoundsTerms = 3;
 // Re-seeding's pair restarts: random frames per parameterization, and how far
 // above the current objective a pair's replacement may start to get them.
 constexpr int kPairRestarts = 8;
+constexpr double kPairRestartWithin = 3;
 // The mixed pair's restarts (2 terms) run their Powell at half the search's
 // texture, not below this (nor above the search's): they look for a basin,
 // and the one kept is read and polished at the search's texture. W1: 22,678
 // -> 19,278 fits and 0.64x the wall time, the same answer.
 constexpr int kPairRestartMinTexture = 8;
-constexpr double kPairRestartWithin = 3;
 
 struct Term {
   Rotation4 R;
