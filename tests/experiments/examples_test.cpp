@@ -96,7 +96,7 @@ TEST_CASE("examples: cornell-validation at reduced size") {
   run_example("cornell-validation",
               {"method.texture_size=6", "method.restarts=1", "method.terms=2", "brdf.model=[\"krylon-blue\"]",
                "sampling.symmetries=\"off\""},
-              3);
+              4);
 }
 
 TEST_CASE("examples: cornell-baselines at reduced size") {
