@@ -78,10 +78,10 @@ class MethodKind {
   virtual bool seeded() const { return false; }
   // Options shown in the run's one-line description (in this order).
   virtual std::vector<std::string> described() const = 0;
-  // The value shown for one of them (options[key] unless the kind says
+  // The value shown for one of them (m.options[key] unless the kind says
   // better, e.g. a search whose terms each choose their parameterization).
-  virtual nlohmann::json described_value(const nlohmann::json& options, const std::string& key) const {
-    return options.at(key);
+  virtual nlohmann::json described_value(const MethodVariant& m, const std::string& key) const {
+    return m.options.at(key);
   }
   // Results columns beyond the common ones that a successful run of this
   // kind fills (checked by the generic catalogue test).

@@ -290,11 +290,11 @@ class SearchKind final : public HomomorphicKind {
     return {"parameterization", "terms", "texture_size", "reciprocity", "restarts", "optimizer", "beam",
             "backfit_sweeps", "seed"};
   }
-  // A search whose terms each choose wiwo or halfdiff shows "either" (the
-  // `parameterization` option then holds only the greedy search's default).
-  json described_value(const json& o, const std::string& key) const override {
-    if (key == "parameterization" && o.value("term_param", "") == "either") return "either";
-    return o.at(key);
+  // `parameterization` as the results column has it: "either" for a search
+  // whose terms each choose (the option then holds only greedy's default).
+  json described_value(const MethodVariant& m, const std::string& key) const override {
+    if (key == "parameterization") return asked_parameterization(homomorphic_options(m).search);
+    return m.options.at(key);
   }
   bool array_is_value(const std::string& key, const toml::array& a) const override {
     return key == "guesses" && !all_arrays(a);

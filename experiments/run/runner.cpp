@@ -78,7 +78,7 @@ std::string describe_method(const MethodVariant& m) {
   if (m.label != m.kind) s += " (" + m.kind + ")";
   for (const auto& k : m.impl->described())
     if (m.options.contains(k)) {
-      const json v = m.impl->described_value(m.options, k);
+      const json v = m.impl->described_value(m, k);
       if (v.is_number_integer() && v.get<int64_t>() < 0) continue;  // -1: chosen at run time (sh-r orders)
       s += " " + k + "=" + (v.is_string() ? v.get<std::string>() : v.dump());
     }
