@@ -370,6 +370,8 @@ SampleSet MerlBrdf::samples(int stride, bool measure_weights) const {
   // The format stores an isotropic, reciprocal BRDF (phi_h dropped, phi_d folded
   // by reciprocity); it does not assume the mirror phi_d -> -phi_d.
   s.symmetries = {true, true, false};
+  // A cell's phi_h = 0 is the format's storage convention: it stands for every azimuth.
+  s.representatives = true;
   s.validate();
   return s;
 }

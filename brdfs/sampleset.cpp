@@ -59,6 +59,7 @@ SampleSet SampleSet::compacted() const {
   SampleSet out;
   out.description = description;
   out.symmetries = symmetries;
+  out.representatives = representatives;
   for (size_t k = 0; k < size(); ++k)
     if (valid[k]) out.push(wi[k], wo[k], value[k], weight_of(k));
   out.validate();

@@ -25,6 +25,11 @@ struct SampleSet {
   // three; MERL cells: isotropic + reciprocal; CSV: none), a config or
   // bf.SampleSet may declare more. Builders from a BRDF leave it none.
   Symmetries symmetries;
+  // True when a sample's position is its orbit's representative by the
+  // format's convention, not where it was measured: a MERL cell is stored at
+  // phi_h = 0 because the format drops phi_h, and stands for every azimuth
+  // alike. Runs score such samples over their orbit (docs/design.md §4.3).
+  bool representatives = false;
 
   // Counts of masked samples by reason (filled by validate()).
   size_t invalid_value = 0;    // NaN, Inf or negative in any channel

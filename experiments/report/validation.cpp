@@ -26,6 +26,7 @@ HoldoutSplit partition_held(const SampleSet& s, const std::vector<uint8_t>& held
   out.train.invalid_horizon = s.invalid_horizon;
   out.train.invalid_weight = s.invalid_weight;
   out.train.symmetries = out.held.symmetries = s.symmetries;
+  out.train.representatives = out.held.representatives = s.representatives;
   return out;
 }
 

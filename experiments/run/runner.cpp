@@ -216,6 +216,21 @@ void set_presentation(Row& row, const Plan& plan, const PlannedRun& r) {
   row["sampling"] = plan.samplings[r.sampling].label;
 }
 
+// The results column and run.json entry `symmetries`: the key, what the samples
+// declare, what the fit used, its orbit, and whether metrics score the orbit.
+void record_symmetries(const SymmetryChoice& sym, const OrbitInfo& orbit, Row& row, json& rec) {
+  row["symmetries"] = sym.used.to_string();
+  rec["symmetries"] = {{"key", sym.key}, {"declared", sym.declared.to_string()}, {"used", sym.used.to_string()}};
+  if (sym.used.any()) rec["symmetries"]["orbit"] = orbit.describe();
+  if (sym.score_orbit) rec["symmetries"]["metrics"] = scored_over_orbit_note(sym);
+}
+
+// Training or held-out metrics of f on s, scored where scored_set says.
+Metrics scored_metrics(const Brdf& f, const SampleSet& s, const SymmetryChoice& sym, const LogTransform& lt) {
+  std::optional<SampleSet> orbit;
+  return evaluate_metrics(f, scored_set(s, sym, orbit), lt);
+}
+
 // What the held-out fits of a run found (held_out_stage).
 struct HeldOutStage {
   std::optional<FoldSummary> folds;  // with experiment.folds: the folds' scores
@@ -311,7 +326,7 @@ HeldOutStage held_out_stage(const Plan& plan, const PlannedRun& pr, const Method
                         [&] { return renders.get(plan, pr.brdf); }};
     const MethodOutcome fo = kind.run(fc);
     if (!fo.result) throw std::runtime_error("method " + mv.kind + " returned no factorization");
-    return evaluate_metrics(*fo.result, h.held, flt);
+    return scored_metrics(*fo.result, h.held, sym, flt);
   };
   // A key chosen by held-out error (MethodVariant::cv): each candidate fitted
   // without the held-out samples (every fold, or the single fraction), the
@@ -434,9 +449,7 @@ RunEntry execute_run(const Plan& plan, const PlannedRun& pr, const SampleSet& sa
   const FillChoice& fill = prep.fill;
   const SampleSet& fit_view = prep.view;
   if (plan.samplings[pr.sampling].kind == "measured") rec["fill"] = fill.describe();
-  row["symmetries"] = sym.used.to_string();
-  rec["symmetries"] = {{"key", sym.key}, {"declared", sym.declared.to_string()}, {"used", sym.used.to_string()}};
-  if (sym.used.any()) rec["symmetries"]["orbit"] = orbit.describe();
+  record_symmetries(sym, orbit, row, rec);
   std::string why_no_domain;
   const auto domain = b.brdf->whole_domain(&why_no_domain) ? renders.validation(plan, pr.brdf) : nullptr;
   const LogTransform lt = LogTransform::of(fit_samples, plan.experiment.metric_eps);
@@ -463,7 +476,7 @@ RunEntry execute_run(const Plan& plan, const PlannedRun& pr, const SampleSet& sa
   MethodOutcome out = kind.run(c);
   const double seconds = since(t0);
   if (!out.result) throw std::runtime_error("method " + m.kind + " returned no factorization");
-  const Metrics mt = evaluate_metrics(*out.result, fit_samples, lt);
+  const Metrics mt = scored_metrics(*out.result, fit_samples, sym, lt);
   if (weighted) row["scene_rel_mse"] = format_number(evaluate_metrics(*out.result, *weighted, lt).rel_mse);
 
   // The kind's columns (the required ones empty unless it fills them), then the common ones.
@@ -476,10 +489,13 @@ RunEntry execute_run(const Plan& plan, const PlannedRun& pr, const SampleSet& sa
   notes.insert(notes.end(), cache_notes.begin(), cache_notes.end());
   {  // Validation on data the fit never saw, and its flags.
     const auto tv = Clock::now();
-    ValidationScores vs = score_validation(*out.result, domain.get(), split ? &split->held : nullptr, lt);
+    std::optional<SampleSet> orbit_of_held;
+    const SampleSet* held_scored = split ? &scored_set(split->held, sym, orbit_of_held) : nullptr;
+    ValidationScores vs = score_validation(*out.result, domain.get(), held_scored, lt);
     if (fold_summary) vs.holdout = true, vs.held = fold_summary->mean();
     std::string scheme = validation_scheme(plan, b, domain.get(), vs, split ? &*split : nullptr,
                                            fold_summary ? &*fold_summary : nullptr, samples.valid_count());
+    if (sym.score_orbit && (split || fold_summary)) scheme += "; " + scored_over_orbit_note(sym);
     if (!domain && plan.experiment.validation_pairs != 0)
       scheme = "no whole-domain columns: " + why_no_domain + (scheme.empty() ? "" : "; " + scheme);
     fill_validation_columns(vs, mt.rel_mse, scheme, row, notes);

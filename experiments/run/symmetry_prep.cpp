@@ -12,12 +12,24 @@ SymmetryChoice choose_symmetries(const SamplingVariant& s, const SampleSet& samp
   if (c.key == "off" || c.key == "none") return c;
   if (c.key == "auto") {
     if (s.raw()) c.used = c.declared;
-    return c;
+  } else {
+    // Validated when the config was read (config.cpp), so this does not throw there.
+    c.declared = parse_symmetries(c.key, s.where + ": sampling.symmetries");
+    c.used = c.declared;
   }
-  // Validated when the config was read (config.cpp), so this does not throw there.
-  c.declared = parse_symmetries(c.key, s.where + ": sampling.symmetries");
-  c.used = c.declared;
+  c.score_orbit = samples.representatives && c.used.any();
   return c;
+}
+
+const SampleSet& scored_set(const SampleSet& s, const SymmetryChoice& c, std::optional<SampleSet>& storage) {
+  if (!c.score_orbit) return s;
+  storage = expand_orbit(s, c.used, kRunOrbit);
+  return *storage;
+}
+
+std::string scored_over_orbit_note(const SymmetryChoice& c) {
+  return "training and held-out samples scored over their orbit (" + c.used.to_string() +
+         "), not at the table's phi_h = 0 alone";
 }
 
 SampleSet fit_set(const SampleSet& train, const SymmetryChoice& c, OrbitInfo* info) {

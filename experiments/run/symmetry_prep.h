@@ -5,6 +5,7 @@
 // held-out split stay on the raw samples.
 #pragma once
 
+#include <optional>
 #include <string>
 
 #include "brdfs/sampleset.h"
@@ -24,8 +25,25 @@ struct SymmetryChoice {
   Symmetries declared;  // what the samples declare (after the key's declaration)
   Symmetries used;      // what the orbit expansion uses
   std::string key;      // the key's value
+  // The samples are their orbit's representatives (SampleSet::representatives,
+  // a MERL table's cells) and the fit uses symmetries: metrics score each
+  // sample over its orbit (scored_set).
+  bool score_orbit = false;
 };
 SymmetryChoice choose_symmetries(const SamplingVariant& s, const SampleSet& samples);
+
+// The samples a run's training and held-out metrics are scored on: `s`
+// itself, or, when c.score_orbit, each valid sample's orbit under c.used
+// (expand_orbit with kRunOrbit; every copy at weight / |orbit|, so each
+// sample keeps its weight). A MERL cell's position phi_h = 0 is the format's
+// convention, and the fit that uses its orbit is not meant to be better
+// there than at any other azimuth; scored at phi_h = 0 alone its error read
+// up to 3.4x below the same fit's whole-domain error (docs/design.md §4.3).
+// `storage` holds the expansion; the result refers to it or to `s`.
+const SampleSet& scored_set(const SampleSet& s, const SymmetryChoice& c, std::optional<SampleSet>& storage);
+// "training and held-out samples scored over their orbit (isotropic+reciprocal),
+// not at the table's phi_h = 0 alone" (the `validation` column and run.json).
+std::string scored_over_orbit_note(const SymmetryChoice& c);
 
 // The orbit a run's fit uses (kRunOrbit) and the share of each measured
 // sample's weight that stays on the sample (kRawShare) are defined beside
