@@ -438,7 +438,8 @@ RunEntry execute_run(const Plan& plan, const PlannedRun& pr, const SampleSet& sa
   const bool use_folds = !folds.empty();
   const SampleSet& fit_samples = split ? split->train : samples;
   // Symmetries (experiments/run/symmetry_prep.h): the fit sees each raw training
-  // sample's orbit; metrics and the held-out split stay on the raw samples.
+  // sample's orbit; the held-out split stays on the raw samples, and so do the
+  // metrics unless the samples are their orbit's representatives (scored_set).
   const SymmetryChoice sym = choose_symmetries(plan.samplings[pr.sampling], samples);
   OrbitInfo orbit;
   // Kinds that tabulate the BRDF (svd, sh-k, sh-r) see a measured BRDF made of

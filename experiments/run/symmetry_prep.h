@@ -1,8 +1,9 @@
 // Symmetries as data preparation for a run (docs/design.md §4.3
 // "symmetries"): which symmetries the fit's samples stand for, and the
 // training set with each raw sample replaced by its orbit (brdfs/symmetry.h).
-// The fitters see an ordinary weighted SampleSet; training metrics and the
-// held-out split stay on the raw samples.
+// The fitters see an ordinary weighted SampleSet; the held-out split stays
+// on the raw samples, and so do training and held-out metrics, except for
+// samples that are their orbit's representatives (scored_set).
 #pragma once
 
 #include <optional>
