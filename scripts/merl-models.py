@@ -9,6 +9,7 @@ table's own score against the model (its binning floor):
 
     python3 scripts/merl-models.py [--bin build/experiments/brdf-factor]
                                    [--out results/merl-models] [--search]
+                                   [--model NAME[:k=v,...] ...]
 
 Prints the markdown table of docs/results.md §5a "MERL tables of analytic
 models" and the two criteria: val_rel_mse <= 2x holdout_rel_mse, and the
@@ -43,16 +44,18 @@ def main():
     ap.add_argument("--bin", default="build/experiments/brdf-factor")
     ap.add_argument("--out", default="results/merl-models")
     ap.add_argument("--search", action="store_true", help="also the default 2-term search (about 30 s a table)")
+    ap.add_argument("--model", action="append", help="a catalogue name[:k=v,...] (repeat) instead of the 13 of results.md")
     a = ap.parse_args()
+    models = a.model or MODELS
     binary = os.path.abspath(a.bin)
     out = os.path.abspath(a.out)
     tables = os.path.join(out, "tables")
     os.makedirs(tables, exist_ok=True)
-    for m in MODELS:
+    for m in models:
         path = os.path.join(tables, table_name(m))
         if not os.path.exists(path):
             subprocess.run([binary, "export-merl", "--brdf", m, "--out", path], check=True, capture_output=True)
-    files = ", ".join('"%s"' % os.path.join(tables, table_name(m)) for m in MODELS)
+    files = ", ".join('"%s"' % os.path.join(tables, table_name(m)) for m in models)
     methods = '[[method]]\nkind = "mccool"\ntexture_size = 16\n'
     if a.search:
         methods += '\n[[method]]\nkind = "search"\nterms = 2\n'
@@ -72,7 +75,7 @@ def main():
           "| vs model | vs model / table's | shade_rmse |")
     print("|---|---|---|---|---|---|---|---|---|---|")
     ratios, floors, n = [], [], 0
-    for m in MODELS:
+    for m in models:
         t = os.path.join(tables, table_name(m))
         own = compare(binary, t, m)
         for r in sorted(by_file.get(table_name(m), []), key=lambda r: r["method"]):
