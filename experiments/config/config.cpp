@@ -289,9 +289,9 @@ void read_brdfs(const toml::node* node, Ctx& ctx, std::vector<BrdfVariant>& out)
           // Spectral files: the gamut mapping's floor shapes the samples (brdfs/spectral.h).
           const std::string ext = fs::path(resolved).extension().string();
           if (ext == ".astm" || ext == ".brdf") b.identity["gamut_floor"] = kGamutFloor;
-          // MERL tables: training and held-out metrics score each cell over its orbit
-          // (experiments/run/symmetry_prep.h scored_set); runs cached before that rule differ.
-          if (ext == ".binary") b.identity["cells_scored_over_orbit"] = true;
+          // MERL rules that change results (symmetry_prep.h scored_set, runner.cpp
+          // prepare_fit's fill): runs cached before them differ.
+          if (ext == ".binary") b.identity["merl_rules"] = "cells scored over their orbit; fill of the training cells";
           b.label = name.empty() ? src : name;
         } else {
           b.brdf = Catalogue::global().make(src, bp.params);

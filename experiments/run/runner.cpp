@@ -246,18 +246,23 @@ struct HeldOutStage {
 // the fit set (the training samples' orbit plus the fill).
 struct FitPrep {
   BrdfVariant brdf;
-  FillChoice fill;  // fill.truth points into brdf's shared BRDF
+  BrdfPtr training;  // measured: the BRDF made of `train` (the fill's truth), else null
+  FillChoice fill;   // fill.truth points into `training` or brdf's shared BRDF
   SampleSet view;
 };
 FitPrep prepare_fit(const Plan& plan, const PlannedRun& pr, const SampleSet& train, bool held_out,
                     const SymmetryChoice& sym, OrbitInfo* orbit) {
-  FitPrep p{plan.brdfs[pr.brdf], {}, {}};
+  FitPrep p{plan.brdfs[pr.brdf], nullptr, {}, {}};
 #ifdef BF_RUNNER_HAVE_MEASURED
-  if (held_out && p.brdf.measured)
-    if (BrdfPtr t = measured_from_training(*p.brdf.brdf, train)) p.brdf.brdf = std::move(t);
+  // The fill reads the training BRDF whether or not samples were held out (a
+  // MERL table's is read trilinearly; with the table's own nearest lookup a fit
+  // without held-out cells was 5x worse than one with them); the tabulating
+  // kinds see it only when samples were held out.
+  if (p.brdf.measured) p.training = measured_from_training(*p.brdf.brdf, train);
+  if (held_out && p.training) p.brdf.brdf = p.training;
 #endif
-  p.fill = choose_fill(plan.samplings[pr.sampling], p.brdf.measured ? p.brdf.brdf.get() : nullptr, sym,
-                       fill_seed(plan.experiment.seed));
+  const Brdf* truth = p.training ? p.training.get() : p.brdf.measured ? p.brdf.brdf.get() : nullptr;
+  p.fill = choose_fill(plan.samplings[pr.sampling], truth, sym, fill_seed(plan.experiment.seed));
   p.view = with_fill(fit_set(train, sym, orbit), p.fill);
   return p;
 }
@@ -496,7 +501,7 @@ RunEntry execute_run(const Plan& plan, const PlannedRun& pr, const SampleSet& sa
     if (fold_summary) vs.holdout = true, vs.held = fold_summary->mean();
     std::string scheme = validation_scheme(plan, b, domain.get(), vs, split ? &*split : nullptr,
                                            fold_summary ? &*fold_summary : nullptr, samples.valid_count());
-    if (sym.score_orbit && (split || fold_summary)) scheme += "; " + scored_over_orbit_note(sym);
+    if (sym.score_orbit) scheme += (scheme.empty() ? "" : "; ") + scored_over_orbit_note(sym);
     if (!domain && plan.experiment.validation_pairs != 0)
       scheme = "no whole-domain columns: " + why_no_domain + (scheme.empty() ? "" : "; " + scheme);
     fill_validation_columns(vs, mt.rel_mse, scheme, row, notes);

@@ -103,6 +103,13 @@ TEST_CASE("symmetry run: a MERL table's cells are scored over their orbit, so he
   CHECK(train == Approx(held).epsilon(0.05));  // 1.1 M training cells do not overfit 3 textures of 16x16
   const nlohmann::json rec = nlohmann::json::parse(read_text(tmp / ("a/runs/" + a.at("run_id") + "/run.json")));
   CHECK(rec.at("symmetries").at("metrics").get<std::string>().find("scored over their orbit") != std::string::npos);
+  // Nothing held out: the training columns are still scored over the orbit, and the row says so.
+  run_quiet(write_text(tmp / "b.toml", std::string(cfg).insert(cfg.find("[[brdf]]"), "holdout = 0\n")), tmp / "b");
+  const Row b = read_results_csv(tmp / "b/results.csv").at(0);
+  INFO("b: validation = " << b.at("validation"));
+  CHECK(b.at("holdout_rel_mse").empty());
+  CHECK(b.at("validation").find("scored over their orbit (isotropic+reciprocal)") != std::string::npos);
+  CHECK(std::stod(b.at("rel_mse")) == Approx(train).epsilon(0.05));
 }
 
 TEST_CASE("symmetry run: only representatives are scored over their orbit, and each keeps its weight") {
