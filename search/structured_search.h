@@ -73,7 +73,9 @@ SearchResult structured_search(const FitData& data, const SearchOptions& opt);
 // older revision is recomputed instead of reused. 2: 2-term searches run
 // the mixed pair's random restarts (2026-11-28). 3: those restarts search
 // at half the texture, and also in the answer's mix when its two terms
-// share a parameterization (2026-11-29).
+// share a parameterization (2026-11-29). (final_reciprocity, 2026-11-29,
+// did not raise it: its key entered the run id, and with it off the answers
+// are those of revision 3.)
 constexpr int kStructuredSearchRevision = 3;
 
 }  // namespace bf

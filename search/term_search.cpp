@@ -496,16 +496,60 @@ void refit_search_result(const FitData& data, const SearchOptions& opt, SearchRe
   r.factorization = r.answers.back();
 }
 
+namespace {
+
+// final_reciprocity: each structured answer refit with its terms reciprocal,
+// kept when lower on `data` (in parallel; a refit that fails to solve leaves
+// the answer as it was).
+void reciprocal_refits(const FitData& data, const SearchOptions& opt, SearchResult& r) {
+  if (!opt.final_reciprocity || opt.reciprocity || r.answers.empty()) return;
+  const size_t J = r.answers.size();
+  r.reciprocal_answers.assign(J, false);
+  std::vector<std::shared_ptr<HomomorphicFactorization>> refits(J);
+  std::vector<double> errors(J, std::numeric_limits<double>::infinity());
+  parallel_for(
+      static_cast<int64_t>(J),
+      [&](int64_t b, int64_t e) {
+        for (int64_t k = b; k < e; ++k) {
+          if (!r.answers[k]) continue;
+          std::vector<TermSpec> sp = specs_of(*r.answers[k]);
+          for (TermSpec& t : sp) t.reciprocal = true;
+          std::vector<double> err;
+          try {
+            refits[k] = fit_homomorphic(data, sp, refit_options(opt, static_cast<int>(sp.size())), "search", &err);
+            errors[k] = err.back();
+          } catch (const std::runtime_error&) {
+            refits[k] = nullptr;
+          }
+        }
+      },
+      opt.threads);
+  for (size_t k = 0; k < J; ++k) {
+    if (!r.answers[k]) continue;
+    ++r.evaluations;
+    if (refits[k] && errors[k] < r.rel_mse_after_term[k]) {
+      r.answers[k] = refits[k];
+      r.rel_mse_after_term[k] = errors[k];
+      r.reciprocal_answers[k] = true;
+    }
+  }
+  r.factorization = r.answers.back();
+}
+
+}  // namespace
+
 SearchResult search_factorization(const FitData& data, const SearchOptions& opt) {
   opt.validate();
   if (opt.strategy == "best") return best_of_both(data, opt);
+  const double t0 = now_seconds();
   if (opt.search_samples == 0 || data.size() <= opt.search_samples) {
     SearchResult r = search_on(data, opt);
     r.search_samples = r.data_samples = data.size();
+    reciprocal_refits(data, opt, r);
+    r.seconds = now_seconds() - t0;
     return r;
   }
   // The candidates on a stratified subsample; the answers refit on every sample.
-  const double t0 = now_seconds();
   SubsampleInfo info;
   const FitData sub = stratified_subsample(data, opt.search_samples, opt.seed, &info);
   SearchOptions so = opt;
@@ -515,6 +559,7 @@ SearchResult search_factorization(const FitData& data, const SearchOptions& opt)
     };
   SearchResult r = search_on(sub, so);
   refit_search_result(data, opt, r);
+  reciprocal_refits(data, opt, r);
   r.search_samples = info.samples;
   r.data_samples = info.of;
   r.subsample_seed = info.seed;

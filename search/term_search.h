@@ -93,6 +93,16 @@ struct SearchOptions {
   int restarts = 6;                     // seeded random starts per term, >= 0
   std::vector<std::string> guesses;     // extra starts: "wi", "wo", "wi+wo"
   bool reciprocity = false;             // every term read through its conjugate too
+  // Structured, without `reciprocity`: every k-term answer is also refit with
+  // each of its terms read through its conjugate too (the same planes, the
+  // terms made reciprocal, solved as the answer was), and that refit replaces
+  // the answer when its rel_mse on the fit data is lower. For the samples of a
+  // reciprocal BRDF, closed under the swap, it cannot be higher up to the
+  // smoothing (the swap-average of the answer is such a fit); on W1's 5-term
+  // search it lowers the 2- to 5-term answers 1-20% for one fit per answer
+  // (docs/search.md, step 8). Callers turn it on for data that declare
+  // reciprocity (config "auto").
+  bool final_reciprocity = false;
   FitOptions fit;                       // inner loop (solve_last = n, smoothing, eps)
   uint64_t seed = 1;
   // "powell" (Cole) or an nlopt algorithm: "praxis", "bobyqa", "neldermead",
@@ -144,6 +154,9 @@ struct SearchResult {
   // texture_size. Empty for the greedy search (its k-term answer is the prefix).
   std::vector<std::shared_ptr<HomomorphicFactorization>> answers;
   std::string strategy;                    // the strategy that made it ("best": the winner's)
+  // With final_reciprocity (structured): element k-1 is true when the k-term
+  // answer is the refit with reciprocal terms (it was lower). Else empty.
+  std::vector<bool> reciprocal_answers;
   double search_rel_mse = 0;               // final objective at the search resolution
   std::vector<double> beam_rel_mse;        // final error (texture_size) of each beam branch
   int best_branch = 0;                     // the winning branch (0 = the greedy one)

@@ -224,6 +224,9 @@ struct BenchSearchArgs {
   int solve_last = 2;
   std::string param = "wiwo";
   bool reciprocity = false;
+  // auto (on when the BRDF is reciprocal, as a config's default), on or off.
+  std::string final_reciprocity = "auto";
+  bool brdf_reciprocal = false;  // filled from the BRDF (run_bench_search)
   unsigned long long seed = 1;
   std::string optimizer = "powell";
   int threads = 0;
@@ -257,6 +260,8 @@ SearchOptions bench_search_options(const BenchSearchArgs& a, const std::string& 
   opt.restarts = a.restarts;
   opt.guesses = a.guesses;
   opt.reciprocity = a.reciprocity;
+  opt.final_reciprocity =
+      a.final_reciprocity == "on" || (a.final_reciprocity == "auto" && a.brdf_reciprocal);
   opt.fit.solve_last = a.solve_last;
   opt.fit.smoothing = a.smoothing;
   opt.seed = a.seed;
@@ -285,6 +290,8 @@ nlohmann::json bench_one_search(const BenchSearchArgs& a, const FitData& d, cons
   j["term_param"] = a.term_param;
   j["search_strategy"] = r.strategy;
   j["reciprocity"] = a.reciprocity;
+  j["final_reciprocity"] = opt.final_reciprocity;
+  j["reciprocal_answers"] = r.reciprocal_answers;
   j["sampling"] = a.sampling;
   j["samples"] = d.size();
   j["texture"] = a.texture;
@@ -321,8 +328,10 @@ nlohmann::json bench_one_search(const BenchSearchArgs& a, const FitData& d, cons
   return j;
 }
 
-void run_bench_search(const BenchSearchArgs& a) {
-  const BrdfPtr brdf = Catalogue::builtin().make(a.brdf);
+void run_bench_search(const BenchSearchArgs& args) {
+  const BrdfPtr brdf = Catalogue::builtin().make(args.brdf);
+  BenchSearchArgs a = args;
+  a.brdf_reciprocal = brdf->reciprocal();
   SampleSet s = a.sampling == "measured" ? measured_samples(*brdf) : sample_grid(*brdf, a.grid);
   if (a.perturb != 0) {
     // Every value times 1 + perturb * u, u uniform in [-1, 1] from a fixed seed:
@@ -766,6 +775,11 @@ void add_bench_search(CLI::App* bench) {
   search->add_option("--solve-last", b->solve_last, "terms solved jointly (n)")->capture_default_str();
   search->add_option("--parameterization", b->param, "wiwo or halfdiff")->capture_default_str();
   search->add_flag("--reciprocity", b->reciprocity, "read each texture through the conjugate too");
+  search->add_option("--final-reciprocity", b->final_reciprocity,
+                     "structured: refit each answer with its terms reciprocal and keep it when lower; auto = "
+                     "when the BRDF is reciprocal (the config default)")
+      ->check(CLI::IsMember({"auto", "on", "off"}))
+      ->capture_default_str();
   search->add_option("--seed", b->seed, "seed of the random starts")
       ->check(non_negative_integer())
       ->capture_default_str();

@@ -22,6 +22,9 @@ struct SearchCvCache;
 struct HomomorphicOptions {
   Parameterization param = Parameterization::WiWo;
   bool reciprocity = false;
+  // search: "auto" (on when the BRDF declares reciprocity and sampling.symmetries
+  // does not leave it out), "true" or "false" (SearchOptions::final_reciprocity).
+  std::string final_reciprocity = "auto";
   FitOptions fit;                    // mccool, fit, search (search.fit mirrors it)
   std::vector<TermSpec> projections; // fit: all configured projections at texture_size
   SearchOptions search;              // search

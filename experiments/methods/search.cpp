@@ -7,6 +7,7 @@
 #include <map>
 #include <mutex>
 
+#include "brdfs/symmetry.h"
 #include "experiments/methods/homomorphic.h"
 #include "factor/size_select.h"
 #include "search/rotation4.h"
@@ -100,6 +101,13 @@ const std::vector<KeySpec>& search_keys() {
         int_key("restarts", 0, 100000, "6", "seeded random starts per term"),
         other_key("guesses", "list of `\"wi\"`, `\"wo\"`, `\"wi+wo\"`", "[]", "extra starts"),
         bool_key("reciprocity", "false", "every term read through its conjugate too"),
+        other_key("final_reciprocity", "`\"auto\"`, true or false", "`\"auto\"`",
+                  "structured, without `reciprocity`: every k-term answer is also refit with its terms read "
+                  "through their conjugates too (the same planes) and kept when its rel_mse on the fit samples is "
+                  "lower. `\"auto\"`: when the BRDF declares reciprocity (an analytic model's formula, a "
+                  "Cornell, pbrt or MERL file, a CSV's declaration) and `sampling.symmetries` does not leave it "
+                  "out. Column `reciprocity` (`true` / `mixed` / `false`), run.json `final_reciprocity`. "
+                  "docs/search.md \"Reciprocal answers\""),
         choice_key("optimizer", {"powell", "praxis", "bobyqa", "neldermead", "sbplx", "direct", "crs"}, "powell", ""),
         num_key("ftol", 0.0, 1.0, true, "1e-3",
                 "relative improvement per sweep below which Powell stops (also nlopt's ftol)"),
@@ -191,6 +199,37 @@ void read_search_samples(Reader& r, SearchOptions& s) {
   s.search_samples = static_cast<size_t>(v->get());
 }
 
+// final_reciprocity: "auto", true or false (stored as "auto", "true", "false").
+void read_final_reciprocity(Reader& r, HomomorphicOptions& h) {
+  const toml::node* n = r.take("final_reciprocity");
+  if (!n) return;
+  if (auto b = n->as_boolean()) {
+    h.final_reciprocity = b->get() ? "true" : "false";
+    return;
+  }
+  auto str = n->as_string();
+  if (str && str->get() == "auto") return;
+  r.fail("final_reciprocity", "expected \"auto\", true or false, " +
+                                  (str ? "found \"" + str->get() + "\"" : found(*n)));
+}
+
+// Whether a run's search refits its answers with reciprocal terms: the
+// setting, or with "auto" the BRDF's declared reciprocity (a Python call
+// without a BRDF: its samples' declaration) unless the run's
+// sampling.symmetries leaves it out ("off", "none" or a list without it).
+bool final_reciprocity_of(const RunContext& c) {
+  const HomomorphicOptions& h = homomorphic_options(c.method);
+  if (h.search.strategy == "greedy") return false;  // its answers are one schedule's prefixes
+  const std::string& setting = h.final_reciprocity;
+  if (setting != "auto") return setting == "true";
+  // A call from Python has no plan: its samples and BRDF say it.
+  const std::string sym =
+      c.run.sampling < c.plan.samplings.size() ? c.plan.samplings[c.run.sampling].symmetries : "auto";
+  if (sym == "off" || sym == "none") return false;
+  if (sym != "auto" && !parse_symmetries(sym, "sampling.symmetries").reciprocal) return false;
+  return c.brdf.brdf ? c.brdf.brdf->reciprocal() : c.samples.symmetries.reciprocal;
+}
+
 void read_guesses(Reader& r, SearchOptions& s) {
   const toml::node* g = r.take("guesses");
   if (!g) return;
@@ -225,6 +264,7 @@ void record_options(const MethodVariant& m, json& o) {
   o["restarts"] = s.restarts;
   o["guesses"] = s.guesses;
   o["reciprocity"] = h.reciprocity;
+  if (s.strategy != "greedy") o["final_reciprocity"] = h.final_reciprocity;
   o["optimizer"] = s.optimizer;
   o["ftol"] = s.powell.ftol;
   o["line_tol"] = s.powell.line_tol;
@@ -357,6 +397,7 @@ class SearchKind final : public HomomorphicKind {
     read_guesses(r, s);
     read_search_samples(r, s);
     h.reciprocity = r.boolean(key("reciprocity"), false);
+    read_final_reciprocity(r, h);
     s.optimizer = r.choice(key("optimizer"), s.optimizer);
     s.powell.ftol = r.number(key("ftol"), s.powell.ftol);
     s.powell.line_tol = r.number(key("line_tol"), s.powell.line_tol);
@@ -405,6 +446,7 @@ class SearchKind final : public HomomorphicKind {
     const FitData data(c.samples, h.fit.eps);
     if (h.search_cv) return run_cv(c, data);
     SearchOptions so = h.search;
+    so.final_reciprocity = final_reciprocity_of(c);
     SizeChoice choice;  // with a tolerance: the terms tried, filled as the search goes
     if (m.tolerance) {
       // The greedy search stops at the first term whose refit reaches the
@@ -449,7 +491,9 @@ class SearchKind final : public HomomorphicKind {
     }
     const bool reused = base != nullptr;
     if (!base) {
-      base = std::make_shared<const SearchResult>(search_factorization(data, cache.base));
+      SearchOptions so = cache.base;
+      so.final_reciprocity = final_reciprocity_of(c);
+      base = std::make_shared<const SearchResult>(search_factorization(data, so));
       std::lock_guard<std::mutex> lk(cache.mu);
       cache.searched.emplace(key, base);
     }
@@ -473,6 +517,10 @@ class SearchKind final : public HomomorphicKind {
     MethodOutcome out = finish_homomorphic(c, std::move(run), std::move(chosen), sr.evaluations);
     out.record["terms"] = term_records(sr);
     out.record["search_strategy"] = sr.strategy;
+    // Which k-term answers were refit with reciprocal terms (empty: not asked or greedy).
+    out.record["final_reciprocity"] = {{"setting", homomorphic_options(c.method).final_reciprocity},
+                                       {"on", final_reciprocity_of(c)},
+                                       {"reciprocal_answers", sr.reciprocal_answers}};
     // What the search's candidates were evaluated on (the final fit and the
     // metrics use every sample): a stratified subsample above search_samples.
     out.record["search_subsample"] = {{"threshold", homomorphic_options(c.method).search.search_samples},

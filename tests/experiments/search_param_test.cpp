@@ -308,3 +308,61 @@ TEST_CASE("search_samples: 0 and off disable the subsample and bad values are re
   CHECK(a.runs.at(0).run_id == b.runs.at(0).run_id);
   CHECK(a.runs.at(0).run_id != c.runs.at(0).run_id);
 }
+
+TEST_CASE("final_reciprocity: auto follows the BRDF's declared reciprocity, a set value is kept, bad values refused") {
+  // Two BRDFs on a small grid: bluepaint (Lafortune, reciprocal) and
+  // separable (a(wi) b(wo) c(h), not reciprocal); the default 2-term search,
+  // and the same with final_reciprocity = false, and with sampling.symmetries
+  // leaving reciprocity out.
+  ScratchDir tmp;
+  const auto config = [&](const std::string& name, const std::string& sym, const std::string& key) {
+    return write_text(tmp / (name + ".toml"),
+                      "[experiment]\nname = \"fr\"\nseed = 1\nrender = false\n"
+                      "[[brdf]]\npreset = \"bluepaint\"\n[[brdf]]\nmodel = \"separable\"\n"
+                      "[sampling]\nkind = \"grid\"\nresolution = 6\n" + sym +
+                          "[[method]]\nkind = \"search\"\nterms = 2\ntexture_size = 6\nrestarts = 1\nthreads = 1\n" +
+                          key);
+  };
+  struct Case {
+    const char* name;
+    std::string sym, key;
+    bool on_bluepaint;
+  };
+  const std::vector<Case> cases = {{"auto", "", "", true},
+                                   {"off", "", "final_reciprocity = false\n", false},
+                                   {"iso", "symmetries = \"isotropic\"\n", "", false}};
+  std::map<std::string, std::string> ids;
+  for (const Case& k : cases) {
+    const fs::path out = tmp.path / k.name;
+    REQUIRE(run_quiet(config(k.name, k.sym, k.key), out.string()).failed == 0);
+    for (const auto& row : read_results_csv((out / "results.csv").string())) {
+      const bool blue = row.at("brdf") == "bluepaint";
+      INFO(k.name << " " << row.at("brdf") << ": reciprocity " << row.at("reciprocity"));
+      const nlohmann::json rec =
+          nlohmann::json::parse(read_text((out / "runs" / row.at("run_id") / "run.json").string()));
+      const nlohmann::json& fr = rec.at("final_reciprocity");
+      const bool on = blue && k.on_bluepaint;
+      CHECK(fr.at("on") == on);
+      CHECK(fr.at("reciprocal_answers").size() == (on ? 2u : 0u));
+      // On the reciprocal paint the refit is lower and kept: the row's terms are reciprocal.
+      CHECK(row.at("reciprocity") == (on ? "true" : "false"));
+      const auto f = load_factorization((out / "runs" / row.at("run_id") / "factors.json").string());
+      const auto* h = dynamic_cast<const HomomorphicFactorization*>(f.get());
+      REQUIRE(h);
+      for (const FactorTerm& t : h->terms()) CHECK(t.reciprocal == on);
+      if (blue) ids[k.name] = row.at("run_id");
+    }
+  }
+  // The setting enters the run id.
+  CHECK(ids.at("auto") != ids.at("off"));
+  // true is kept even for a BRDF that does not declare reciprocity.
+  const std::string head = std::string(kConfigHead) + "[[method]]\nkind = \"search\"\nterms = 1\nfinal_reciprocity = ";
+  for (const char* ok : {"true", "false", "\"auto\""}) {
+    INFO(ok);
+    CHECK(config_errors(head + ok + "\n").empty());
+  }
+  for (const char* bad : {"\"yes\"", "1", "\"on\""}) {
+    INFO(bad);
+    require_one_config_error(head + bad + "\n", {"final_reciprocity", "expected \"auto\", true or false", "found"});
+  }
+}
