@@ -14,6 +14,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <exception>
 #include <limits>
 #include <mutex>
 #include <stdexcept>
@@ -507,23 +508,37 @@ void reciprocal_refits(const FitData& data, const SearchOptions& opt, SearchResu
   r.reciprocal_answers.assign(J, false);
   std::vector<std::shared_ptr<HomomorphicFactorization>> refits(J);
   std::vector<double> errors(J, std::numeric_limits<double>::infinity());
-  parallel_for(
-      static_cast<int64_t>(J),
-      [&](int64_t b, int64_t e) {
-        for (int64_t k = b; k < e; ++k) {
-          if (!r.answers[k]) continue;
-          std::vector<TermSpec> sp = specs_of(*r.answers[k]);
-          for (TermSpec& t : sp) t.reciprocal = true;
-          std::vector<double> err;
-          try {
-            refits[k] = fit_homomorphic(data, sp, refit_options(opt, static_cast<int>(sp.size())), "search", &err);
-            errors[k] = err.back();
-          } catch (const std::runtime_error&) {
-            refits[k] = nullptr;
-          }
-        }
-      },
-      opt.threads);
+  // Longest first (the J-term answer's joint solve costs the most), each
+  // thread taking the next: the results are by index, so independent of the
+  // scheduling.
+  std::atomic<size_t> next{0};
+  std::mutex mu;
+  std::exception_ptr failure;  // anything but a failed solve (Cancelled): rethrown after the join
+  const auto work = [&] {
+    for (size_t i = next++; i < J; i = next++) {
+      const size_t k = J - 1 - i;
+      if (!r.answers[k]) continue;
+      std::vector<TermSpec> sp = specs_of(*r.answers[k]);
+      for (TermSpec& t : sp) t.reciprocal = true;
+      std::vector<double> err;
+      try {
+        refits[k] = fit_homomorphic(data, sp, refit_options(opt, static_cast<int>(sp.size())), "search", &err);
+        errors[k] = err.back();
+      } catch (const std::runtime_error&) {
+        refits[k] = nullptr;
+      } catch (...) {
+        std::lock_guard<std::mutex> lk(mu);
+        if (!failure) failure = std::current_exception();
+        next = J;
+      }
+    }
+  };
+  std::vector<std::thread> pool;
+  const size_t threads = std::min<size_t>(J, static_cast<size_t>(hardware_threads(opt.threads)));
+  for (size_t t = 1; t < threads; ++t) pool.emplace_back(work);
+  work();
+  for (std::thread& t : pool) t.join();
+  if (failure) std::rethrow_exception(failure);
   for (size_t k = 0; k < J; ++k) {
     if (!r.answers[k]) continue;
     ++r.evaluations;
