@@ -220,6 +220,7 @@ void read_final_reciprocity(Reader& r, HomomorphicOptions& h) {
 bool final_reciprocity_of(const RunContext& c) {
   const HomomorphicOptions& h = homomorphic_options(c.method);
   if (h.search.strategy == "greedy") return false;  // its answers are one schedule's prefixes
+  if (h.reciprocity) return false;                   // its terms are reciprocal already
   const std::string& setting = h.final_reciprocity;
   if (setting != "auto") return setting == "true";
   // A call from Python has no plan: its samples and BRDF say it.
