@@ -74,8 +74,8 @@ SearchResult structured_search(const FitData& data, const SearchOptions& opt);
 // the mixed pair's random restarts (2026-11-28). 3: those restarts search
 // at half the texture, and also in the answer's mix when its two terms
 // share a parameterization (2026-11-29). (final_reciprocity, 2026-11-29,
-// did not raise it: its key entered the run id, and with it off the answers
-// are those of revision 3.)
+// did not raise it: its key enters the run id unless it is off, and with it
+// off the answers are those of revision 3.)
 constexpr int kStructuredSearchRevision = 3;
 
 }  // namespace bf

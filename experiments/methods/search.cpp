@@ -265,7 +265,9 @@ void record_options(const MethodVariant& m, json& o) {
   o["restarts"] = s.restarts;
   o["guesses"] = s.guesses;
   o["reciprocity"] = h.reciprocity;
-  if (s.strategy != "greedy") o["final_reciprocity"] = h.final_reciprocity;
+  // In the run id unless "false": a structured search with it off is the search of
+  // before the key (structured revision 3), whose cached runs stay valid.
+  if (s.strategy != "greedy" && h.final_reciprocity != "false") o["final_reciprocity"] = h.final_reciprocity;
   o["optimizer"] = s.optimizer;
   o["ftol"] = s.powell.ftol;
   o["line_tol"] = s.powell.line_tol;

@@ -356,8 +356,15 @@ TEST_CASE("final_reciprocity: auto follows the BRDF's declared reciprocity, a se
       if (blue) ids[k.name] = row.at("run_id");
     }
   }
-  // The setting enters the run id.
+  // The setting enters the run id unless it is off (the search of before the key).
   CHECK(ids.at("auto") != ids.at("off"));
+  const std::string one = std::string(kConfigHead) + "[[method]]\nkind = \"search\"\nterms = 1\n";
+  const Plan pa = parse_plan(one, "cfg.toml", {}), pf = parse_plan(one + "final_reciprocity = false\n", "cfg.toml", {}),
+             pt = parse_plan(one + "final_reciprocity = true\n", "cfg.toml", {});
+  CHECK_FALSE(pf.runs.at(0).identity.at("method").contains("final_reciprocity"));
+  CHECK(pa.runs.at(0).identity.at("method").at("final_reciprocity") == "auto");
+  CHECK(pa.runs.at(0).run_id != pf.runs.at(0).run_id);
+  CHECK(pt.runs.at(0).run_id != pf.runs.at(0).run_id);
   // true is kept even for a BRDF that does not declare reciprocity.
   const std::string head = std::string(kConfigHead) + "[[method]]\nkind = \"search\"\nterms = 1\nfinal_reciprocity = ";
   for (const char* ok : {"true", "false", "\"auto\""}) {
