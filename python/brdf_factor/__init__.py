@@ -150,16 +150,27 @@ def _check_regular_file(path, what, max_bytes=2 << 30):
         raise ValueError("%s: %s: %d bytes, more than the limit of %d" % (path, what, st.st_size, max_bytes))
 
 
+# Columns that are text whatever they look like: a run id is 12 hex digits
+# and can be all decimal ("012345678901" must not become 12345678901), a
+# label or BRDF name can be a number.
+_TEXT_COLUMNS = frozenset(("run_id", "brdf", "method", "label", "sampling", "sweep", "notes", "flag",
+                           "validation", "parameterization", "term_parameterizations", "search_strategy"))
+
+
 def results(path, frame=False):
     """An experiment folder's results.csv (or the file itself) as a list of
     dicts, one per run, numbers as int/float, empty cells as None; with
-    frame=True a pandas DataFrame (pandas must be installed)."""
+    frame=True a pandas DataFrame (pandas must be installed). The text
+    columns (run_id, brdf, method, label, sampling, sweep, notes, flag,
+    validation, parameterization, term_parameterizations, search_strategy)
+    stay strings: a run id of decimal digits only is still a run id."""
     path = _os.fspath(path)
     if _os.path.isdir(path):
         path = _os.path.join(path, "results.csv")
     _check_regular_file(path, "results table")
     with open(path, newline="") as f:
-        rows = [{k: _value(v) for k, v in row.items()} for row in _csv.DictReader(f)]
+        rows = [{k: ((v or None) if k in _TEXT_COLUMNS else _value(v)) for k, v in row.items()}
+                for row in _csv.DictReader(f)]
     if frame:
         import pandas  # noqa: raises ImportError naming pandas when it is missing
         return pandas.DataFrame(rows)

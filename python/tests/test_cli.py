@@ -40,6 +40,7 @@ terms = 2
 texture_size = 8
 restarts = 2
 threads = 1
+final_reciprocity = true
 
 [[method]]
 kind = "svd"
@@ -76,7 +77,10 @@ threads = 1
 DIRECT = {
     "mccool": lambda s, b: bf.mccool(s, texture_size=8),
     "fit": lambda s, b: bf.fit(s, projections=["wi", "h"], texture_size=8),
-    "search": lambda s, b: bf.search(s, terms=2, texture_size=8, restarts=2, threads=1, seed=1),
+    # final_reciprocity set: "auto" reads the BRDF in a config and the samples'
+    # declaration in Python (a grid declares none; docs/search.md, step 8).
+    "search": lambda s, b: bf.search(s, terms=2, texture_size=8, restarts=2, threads=1, seed=1,
+                                     final_reciprocity=True),
     "svd": lambda s, b: bf.svd(b, s, terms=2, texture_size=8),
     "sh-k": lambda s, b: bf.sh_k(b, s, order=4, texture_size=8),
     "sh-r": lambda s, b: bf.sh_r(b, s, order=8, view_order=2, max_order=8, max_view_order=2),
@@ -256,3 +260,17 @@ def test_every_registered_kind_runs_the_same_from_a_config_and_from_python(tmp_p
         assert getattr(bf, kind.replace("-", "_")) is fn and needs in ("samples", "brdf")
         for key in examples[kind]:
             assert key in fn.__doc__, (kind, key)
+
+
+def test_results_keep_text_columns_as_text(tmp_path):
+    # A run id is 12 hex digits and can be decimal digits only, with a leading
+    # zero; it must come back as the same string, not as an int.
+    (tmp_path / "results.csv").write_text(
+        "run_id,brdf,method,label,rel_mse,terms,reciprocity\n"
+        "012345678901,7,search,42,0.5,2,true\n"
+        "a1b2c3d4e5f6,bluepaint,mccool,,0.25,2,mixed\n")
+    rows = bf.results(tmp_path)
+    assert rows[0]["run_id"] == "012345678901"
+    assert rows[0]["brdf"] == "7" and rows[0]["label"] == "42"
+    assert rows[0]["rel_mse"] == 0.5 and rows[0]["terms"] == 2 and rows[0]["reciprocity"] is True
+    assert rows[1]["run_id"] == "a1b2c3d4e5f6" and rows[1]["label"] is None and rows[1]["reciprocity"] == "mixed"
