@@ -1,14 +1,13 @@
 // The structured projection search (see structured_search.h).
 #include "search/structured_search.h"
+#include "solvers/parallel.h"
 
 #include <algorithm>
 #include <array>
-#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <limits>
 #include <memory>
-#include <thread>
 
 #include "search/structure.h"
 
@@ -71,20 +70,11 @@ size_t first_joint(size_t step, int n) {
   return step + 1 > static_cast<size_t>(n) ? step + 1 - n : 0;
 }
 
-// Runs fn(i) for i in [0, n) on the option's threads; results by index, so
-// independent of scheduling.
+// Runs fn(i) for i in [0, n) on the option's threads (solvers/parallel.h
+// parallel_for_each); results by index, so independent of scheduling.
 template <class Fn>
 void parallel_for(size_t n, int threads, Fn fn) {
-  const unsigned hw = std::max(1u, std::thread::hardware_concurrency());
-  const unsigned nthreads = std::min<unsigned>(threads > 0 ? threads : hw, n);
-  std::atomic<size_t> next{0};
-  auto worker = [&] {
-    for (size_t i = next++; i < n; i = next++) fn(i);
-  };
-  std::vector<std::thread> pool;
-  for (unsigned t = 1; t < nthreads; ++t) pool.emplace_back(worker);
-  worker();
-  for (auto& th : pool) th.join();
+  parallel_for_each(static_cast<int64_t>(n), [&](int64_t i) { fn(static_cast<size_t>(i)); }, threads);
 }
 
 bool same_terms(const std::vector<Term>& a, const std::vector<Term>& b) {

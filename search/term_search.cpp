@@ -10,15 +10,11 @@
 #include <nlopt.hpp>
 
 #include <algorithm>
-#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstring>
-#include <exception>
 #include <limits>
-#include <mutex>
 #include <stdexcept>
-#include <thread>
 
 namespace bf {
 
@@ -228,23 +224,18 @@ namespace {
 // Minimizes f from every start, in parallel (results independent of scheduling).
 std::vector<StartResult> run_starts(const RotationObjective& f, const std::vector<Rotation4>& starts,
                                     const SearchOptions& opt) {
-  const unsigned nthreads = static_cast<unsigned>(hardware_threads(opt.threads));
   std::vector<StartResult> results(starts.size());
-  std::atomic<size_t> next{0};
-  auto worker = [&] {
-    for (size_t i = next++; i < starts.size(); i = next++) {
-      if (opt.optimizer == "powell") {
-        const PowellResult p = powell_minimize(f, starts[i], opt.powell);
-        results[i] = {p.best, p.value, p.evaluations};
-      } else {
-        results[i] = nlopt_minimize(f, starts[i], opt);
-      }
-    }
-  };
-  std::vector<std::thread> pool;
-  for (unsigned t = 1; t < std::min<unsigned>(nthreads, starts.size()); ++t) pool.emplace_back(worker);
-  worker();
-  for (auto& th : pool) th.join();
+  parallel_for_each(
+      static_cast<int64_t>(starts.size()),
+      [&](int64_t i) {
+        if (opt.optimizer == "powell") {
+          const PowellResult p = powell_minimize(f, starts[i], opt.powell);
+          results[i] = {p.best, p.value, p.evaluations};
+        } else {
+          results[i] = nlopt_minimize(f, starts[i], opt);
+        }
+      },
+      opt.threads);
   return results;
 }
 
@@ -510,35 +501,24 @@ void reciprocal_refits(const FitData& data, const SearchOptions& opt, SearchResu
   std::vector<double> errors(J, std::numeric_limits<double>::infinity());
   // Longest first (the J-term answer's joint solve costs the most), each
   // thread taking the next: the results are by index, so independent of the
-  // scheduling.
-  std::atomic<size_t> next{0};
-  std::mutex mu;
-  std::exception_ptr failure;  // anything but a failed solve (Cancelled): rethrown after the join
-  const auto work = [&] {
-    for (size_t i = next++; i < J; i = next++) {
-      const size_t k = J - 1 - i;
-      if (!r.answers[k]) continue;
-      std::vector<TermSpec> sp = specs_of(*r.answers[k]);
-      for (TermSpec& t : sp) t.reciprocal = true;
-      std::vector<double> err;
-      try {
-        refits[k] = fit_homomorphic(data, sp, refit_options(opt, static_cast<int>(sp.size())), "search", &err);
-        errors[k] = err.back();
-      } catch (const std::runtime_error&) {
-        refits[k] = nullptr;
-      } catch (...) {
-        std::lock_guard<std::mutex> lk(mu);
-        if (!failure) failure = std::current_exception();
-        next = J;
-      }
-    }
-  };
-  std::vector<std::thread> pool;
-  const size_t threads = std::min<size_t>(J, static_cast<size_t>(hardware_threads(opt.threads)));
-  for (size_t t = 1; t < threads; ++t) pool.emplace_back(work);
-  work();
-  for (std::thread& t : pool) t.join();
-  if (failure) std::rethrow_exception(failure);
+  // scheduling. A failed solve leaves the answer; anything else (Cancelled)
+  // is rethrown.
+  parallel_for_each(
+      static_cast<int64_t>(J),
+      [&](int64_t i) {
+        const size_t k = J - 1 - static_cast<size_t>(i);
+        if (!r.answers[k]) return;
+        std::vector<TermSpec> sp = specs_of(*r.answers[k]);
+        for (TermSpec& t : sp) t.reciprocal = true;
+        std::vector<double> err;
+        try {
+          refits[k] = fit_homomorphic(data, sp, refit_options(opt, static_cast<int>(sp.size())), "search", &err);
+          errors[k] = err.back();
+        } catch (const std::runtime_error&) {
+          refits[k] = nullptr;
+        }
+      },
+      opt.threads);
   for (size_t k = 0; k < J; ++k) {
     if (!r.answers[k]) continue;
     ++r.evaluations;

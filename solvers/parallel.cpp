@@ -2,6 +2,7 @@
 #include "solvers/parallel.h"
 
 #include <algorithm>
+#include <atomic>
 #include <exception>
 #include <mutex>
 #include <thread>
@@ -36,6 +37,31 @@ void parallel_for(int64_t n, const std::function<void(int64_t, int64_t)>& body, 
   pool.reserve(size_t(t - 1));
   for (int64_t k = 1; k < t; ++k) pool.emplace_back(run, k);
   run(0);
+  for (std::thread& th : pool) th.join();
+  if (error) std::rethrow_exception(error);
+}
+
+void parallel_for_each(int64_t n, const std::function<void(int64_t)>& body, int threads) {
+  if (n <= 0) return;
+  const int64_t t = std::min<int64_t>(hardware_threads(threads), n);
+  std::atomic<int64_t> next{0};
+  std::exception_ptr error;
+  std::mutex error_mutex;
+  auto run = [&] {
+    for (int64_t i = next++; i < n; i = next++) {
+      try {
+        body(i);
+      } catch (...) {
+        std::lock_guard<std::mutex> lock(error_mutex);
+        if (!error) error = std::current_exception();
+        next = n;
+      }
+    }
+  };
+  std::vector<std::thread> pool;
+  pool.reserve(size_t(t - 1));
+  for (int64_t k = 1; k < t; ++k) pool.emplace_back(run);
+  run();
   for (std::thread& th : pool) th.join();
   if (error) std::rethrow_exception(error);
 }

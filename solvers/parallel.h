@@ -20,4 +20,12 @@ int hardware_threads(int requested = 0);
 void parallel_for(int64_t n, const std::function<void(int64_t begin, int64_t end)>& body,
                   int threads = 0);
 
+// Calls body(i) for every i in [0, n), from up to `threads` threads (0 = all
+// cores), each thread taking the next index as it finishes one (for items of
+// unequal cost: order them costliest first). The calling thread takes part.
+// A body writing only its own index needs no locking, and results by index do
+// not depend on the scheduling. After the first exception no further index is
+// started; it is rethrown after all threads joined. n <= 0 does nothing.
+void parallel_for_each(int64_t n, const std::function<void(int64_t i)>& body, int threads = 0);
+
 }  // namespace bf
