@@ -81,6 +81,7 @@ std::vector<Vec3> grid_directions(int res) {
 void evaluate_into(const Brdf& brdf, SampleSet& s) {
   s.value.resize(s.size());
   for (size_t k = 0; k < s.size(); ++k) s.value[k] = brdf.eval(s.wi[k], s.wo[k]);
+  s.symmetries = symmetries_of(brdf);  // the values are brdf's: what it claims, they hold
   s.validate();
 }
 

@@ -23,7 +23,9 @@ struct SampleSet {
   // What the data guarantee of the BRDF they sample (brdfs/symmetry.h):
   // readers declare what their format guarantees (ASTM, pbrt .brdf: all
   // three; MERL cells: isotropic + reciprocal; CSV: none), a config or
-  // bf.SampleSet may declare more. Builders from a BRDF leave it none.
+  // bf.SampleSet may declare more. Sets of a BRDF's values (sample_grid,
+  // sample_stratified, evaluate_into) declare what that BRDF claims
+  // (symmetries_of: isotropic(), reciprocal(), bilateral()).
   Symmetries symmetries;
   // True when a sample's position is its orbit's representative by the
   // format's convention, not where it was measured: a MERL cell is stored at
@@ -65,7 +67,8 @@ std::vector<Vec3> grid_directions(int res);
 inline constexpr size_t kMaxStratifiedCount = 10000000;
 SampleSet sample_stratified(const Brdf& brdf, size_t count, uint64_t seed);
 
-// Evaluates brdf at the given direction pairs (values of an existing set are replaced).
+// Evaluates brdf at the given direction pairs (values of an existing set are
+// replaced) and declares brdf's symmetries (symmetries_of) for the set.
 void evaluate_into(const Brdf& brdf, SampleSet& s);
 // Masks (value -1, invalid) every valid sample of s at which `truth` has no
 // data (Brdf::defined_at false: e.g. a MERL table's missing cells) and returns

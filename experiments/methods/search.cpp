@@ -328,10 +328,8 @@ class SearchKind final : public HomomorphicKind {
   }
   std::vector<KeySpec> keys() const override { return search_keys(); }
   bool seeded() const override { return true; }
-  // final_reciprocity set: "auto" reads the BRDF in a config and the samples' declaration in
-  // Python, so the example runs the same from both (python/tests/test_cli.py).
   std::string example() const override {
-    return "terms = 1\ntexture_size = 6\nrestarts = 1\nthreads = 1\nfinal_reciprocity = true\n";
+    return "terms = 1\ntexture_size = 6\nrestarts = 1\nthreads = 1\n";
   }
   std::vector<std::string> described() const override {
     return {"parameterization", "terms", "texture_size", "reciprocity", "restarts", "optimizer", "beam",

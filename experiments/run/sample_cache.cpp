@@ -194,6 +194,8 @@ std::shared_ptr<const SampleSet> make_samples(const Plan& plan, const PlannedRun
         return uint64_t(d) * d;
       }() : s.count;
       if (out->size() == want) {
+        // The declaration is the BRDF's, not the file's (as sample_grid sets it).
+        out->symmetries = symmetries_of(*b.brdf);
         *from_cache = true;
         return out;
       }

@@ -309,3 +309,25 @@ TEST_CASE("cache integrity: a changed finished-run record is reported and the ru
   CHECK_THAT(again, Contains("0 run, 2 cached, 0 failed"));
   CHECK(again.find("warning") == std::string::npos);
 }
+
+TEST_CASE("cache integrity: samples read from the cache declare their BRDF's symmetries as fresh ones do") {
+  // The cache holds the data, not the declaration: a run that reads it must
+  // record (and decide on) the same symmetries as the run that sampled it.
+  Fixture f;
+  int code = 0;
+  const std::string text = f.rerun_without_runs(&code);
+  INFO(text);
+  REQUIRE(code == 0);
+  const auto declared = [](const fs::path& out) {
+    std::vector<std::string> all;
+    for (const auto& e : fs::directory_iterator(out / "runs")) {
+      std::ifstream in(e.path() / "run.json");
+      all.push_back(nlohmann::json::parse(in).at("symmetries").at("declared").get<std::string>());
+    }
+    return all;
+  };
+  const std::vector<std::string> fresh = declared(f.clean), cached = declared(f.out);
+  REQUIRE(fresh.size() == 2);
+  CHECK(cached == fresh);
+  for (const std::string& s : cached) CHECK(s == "isotropic+reciprocal+bilateral");  // bluepaint's claim
+}

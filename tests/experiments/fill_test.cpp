@@ -25,7 +25,7 @@ std::string config(const std::string& sampling, const std::string& method, const
 // Scattered samples of an isotropic model over the whole domain, declaring all three symmetries.
 std::shared_ptr<MeasuredBrdf> declared_interpolant(bool declare) {
   SampleSet s = sample_stratified(*Catalogue::builtin().make("cook-torrance"), 600, 4);
-  if (declare) s.symmetries = Symmetries::all();
+  s.symmetries = declare ? Symmetries::all() : Symmetries::none();  // a stratified set declares the model's
   return std::make_shared<MeasuredBrdf>("planted", s, MeasuredOptions{});
 }
 
