@@ -66,10 +66,6 @@ Rotation4 swapped(const Rotation4& R) {
   return Rotation4::from_matrix(S);
 }
 
-size_t first_joint(size_t step, int n) {
-  return step + 1 > static_cast<size_t>(n) ? step + 1 - n : 0;
-}
-
 // Runs fn(i) for i in [0, n) on the option's threads (solvers/parallel.h
 // parallel_for_each); results by index, so independent of scheduling.
 template <class Fn>

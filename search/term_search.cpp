@@ -239,10 +239,6 @@ std::vector<StartResult> run_starts(const RotationObjective& f, const std::vecto
   return results;
 }
 
-size_t first_joint(size_t step, int n) {  // terms first..step are solved jointly at step
-  return step + 1 > static_cast<size_t>(n) ? step + 1 - n : 0;
-}
-
 // One search path: the projections found so far and the schedule's texels at
 // the search resolution.
 struct Branch {

@@ -223,4 +223,10 @@ class ScheduleObjective {
   int res_;
 };
 
+// The first term solved jointly when term `step` (0-based) is added under a
+// schedule that solves the last `solve_last` terms jointly (FitOptions::solve_last).
+inline size_t first_joint(size_t step, int solve_last) {
+  return step + 1 > static_cast<size_t>(solve_last) ? step + 1 - solve_last : 0;
+}
+
 }  // namespace bf
