@@ -44,7 +44,7 @@ std::string config(const std::string& csv, const std::string& experiment) {
 TEST_CASE("cv: smoothing = cv picks the middle value that a noisy smooth BRDF needs and records it") {
   ScratchDir tmp;
   const std::string csv = noisy_csv(tmp);
-  for (const std::string exp : {std::string("holdout = 0.2\n"), std::string("folds = 3\n")}) {
+  for (const std::string& exp : {std::string("holdout = 0.2\n"), std::string("folds = 3\n")}) {
     INFO(exp);
     const std::string out = tmp / ("o" + std::to_string(exp.size()));
     run_quiet(write_text(out + ".toml", config(csv, exp)), out);

@@ -109,9 +109,9 @@ TEST_CASE("search parameterization: a sweep over wiwo and halfdiff gives rows wh
   // The columns reach results.md and report.html.
   const std::string md = read_text((out / "results.md").string());
   const std::string html = read_text((out / "report.html").string());
-  for (const std::string& col : {"search_strategy", "term_parameterizations"}) {
+  for (const char* col : {"search_strategy", "term_parameterizations"}) {
     CHECK(md.find(col) != std::string::npos);
-    CHECK(html.find("<th>" + col + "</th>") != std::string::npos);
+    CHECK(html.find("<th>" + std::string(col) + "</th>") != std::string::npos);
   }
   CHECK(html.find(">halfdiff+halfdiff<") != std::string::npos);
 }

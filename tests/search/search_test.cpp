@@ -261,7 +261,7 @@ TEST_CASE("search: recovers a planted single-term projection") {
   const FitData d(s, opt.fit.eps);
   const SearchResult res = search_factorization(d, opt);
   // The identity projection (a poor guess) for scale.
-  const auto id = fit_homomorphic(d, {TermSpec{projection_first_pair(Parameterization::WiWo, 8)}},
+  const auto id = fit_homomorphic(d, {TermSpec{projection_first_pair(Parameterization::WiWo, 8), false, std::nullopt}},
                                   opt.fit);
   const double e_id = evaluate_metrics(*id, s, d.transform).rel_mse;
   const double e = evaluate_metrics(*res.factorization, s, d.transform).rel_mse;
