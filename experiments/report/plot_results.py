@@ -21,7 +21,9 @@ Writes into --out (default: plots/ beside the CSV), one file per figure:
 What the figures promise:
   - one series = one method label with one requested parameterization
     (the swept value or the `parameterization` column, never the terms'
-    `term_parameterizations`), reciprocity,
+    `term_parameterizations`), reciprocity (the swept value when swept:
+    a search asked without it whose answers were refit reciprocal is
+    "recip answers", never merged with one asked with it),
     sampling and value of every non-numeric swept option; each series has its
     own colour AND marker (the pair is distinct for up to 60 series);
   - a line joins points only along one swept numeric option, the others held
@@ -96,8 +98,15 @@ def series_name(r, axis_keys):
     p = sweep_of(r).get("parameterization") or r.get("parameterization")
     if p and p not in parts[0]:
         parts.append(p)
-    if r.get("reciprocity") == "true":
+    # Reciprocity as asked: a swept value splits series by the option, and the
+    # column (the result's form) only tells apart a search asked without it
+    # whose answers were refit with reciprocal terms (final_reciprocity). Not
+    # swept, the column says whether the textures are read reciprocally.
+    asked = sweep_of(r).get("reciprocity")
+    if asked == "true" or (asked is None and r.get("reciprocity") == "true"):
         parts.append("recip")
+    elif asked == "false" and r.get("reciprocity") in ("true", "mixed"):
+        parts.append("recip answers")
     for k, v in sweep_of(r).items():
         if k in axis_keys or k in ("parameterization", "reciprocity"):
             continue

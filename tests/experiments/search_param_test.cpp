@@ -233,6 +233,38 @@ TEST_CASE("search parameterization: the plots group a parameterization sweep by 
   CHECK(read_text(tmp / "probe.txt") == "ok\n");
 }
 
+TEST_CASE("search parameterization: the plots split a reciprocity sweep by the asked value") {
+  const std::string py = find_python(nullptr);
+  INFO("no python3 with matplotlib (scripts/install-deps.sh installs python3-matplotlib)");
+  REQUIRE(!py.empty());
+  ScratchDir tmp;
+  // thesis-bluepaint's sweep: reciprocity = [false, true]; the false run's
+  // answers were refit with reciprocal terms (final_reciprocity), so its
+  // column reads true too. Two series, not one drawn over the other.
+  const std::string probe =
+      "import sys; sys.path.insert(0, '" + fs::path(plot_script_path()).parent_path().string() +
+      "'); import plot_results as p\n"
+      "rows = [\n"
+      "  {'label': 's', 'parameterization': 'wiwo', 'reciprocity': 'true',\n"
+      "   'sweep': 'parameterization=wiwo reciprocity=false'},\n"
+      "  {'label': 's', 'parameterization': 'wiwo', 'reciprocity': 'true',\n"
+      "   'sweep': 'parameterization=wiwo reciprocity=true'},\n"
+      "  {'label': 's', 'parameterization': 'wiwo', 'reciprocity': 'false',\n"
+      "   'sweep': 'parameterization=wiwo reciprocity=false'},\n"
+      "  {'label': 'm', 'parameterization': 'wiwo', 'reciprocity': 'true', 'sweep': ''},\n"
+      "  {'label': 'm', 'parameterization': 'wiwo', 'reciprocity': 'false', 'sweep': ''},\n"
+      "]\n"
+      "names = [p.series_name(r, {'terms'}) for r in rows]\n"
+      "assert len(set(names)) == 5, names\n"
+      "assert names[1].endswith(' recip') and names[0].endswith('recip answers'), names\n"
+      "assert 'recip' not in names[2] and 'recip' not in names[4] and names[3].endswith(' recip'), names\n"
+      "print('ok')\n";
+  write_text(tmp / "probe.py", probe);
+  CHECK(std::system((py + " " + (tmp / "probe.py") + " > " + (tmp / "probe.txt") + " 2>&1").c_str()) == 0);
+  INFO(read_text(tmp / "probe.txt"));
+  CHECK(read_text(tmp / "probe.txt") == "ok\n");
+}
+
 TEST_CASE("search parameterization: bench search follows the config's rule") {
   std::string out;
   CHECK(run_cli("bench search --parameterization halfdiff --term-param either", &out) == 2);
