@@ -486,11 +486,52 @@ void refit_search_result(const FitData& data, const SearchOptions& opt, SearchRe
 
 namespace {
 
+// Whether the search's answers get their reciprocal refit (final_reciprocity).
+bool reciprocal_answers_on(const SearchOptions& opt) {
+  return opt.final_reciprocity && !opt.reciprocity && opt.strategy == "structured";
+}
+
+// h's projections fitted on `data` at texture_size with every term reciprocal
+// (*error: its rel_mse); nullptr when that fit fails to solve.
+std::shared_ptr<HomomorphicFactorization> reciprocal_refit(const FitData& data, const SearchOptions& opt,
+                                                           const HomomorphicFactorization& h, double* error) {
+  std::vector<TermSpec> sp = specs_of(h);
+  for (TermSpec& t : sp) t.reciprocal = true;
+  std::vector<double> err;
+  try {
+    auto f = fit_homomorphic(data, sp, refit_options(opt, static_cast<int>(sp.size())), "search", &err);
+    *error = err.back();
+    return f;
+  } catch (const std::runtime_error&) {
+    return nullptr;
+  }
+}
+
+// The stopping rule applied to what the search will answer: the terms so far
+// fitted on every sample (refit: a subsampled search's candidates are not),
+// and, with the reciprocal answers, also their reciprocal refit where it is
+// lower (the answer reciprocal_refits keeps). So a tolerance the refit meets
+// ends the search at that term, not one later.
+std::function<bool(const HomomorphicFactorization&)> answer_stop_rule(const FitData& data, const SearchOptions& opt,
+                                                                       bool refit) {
+  return [&data, &opt, refit](const HomomorphicFactorization& h) {
+    const bool reciprocal = reciprocal_answers_on(opt);
+    std::vector<double> errors;
+    std::shared_ptr<HomomorphicFactorization> fitted;
+    if (refit || reciprocal) fitted = refit_on(data, opt, h, &errors);
+    if (opt.stop_after_term(refit ? *fitted : h)) return true;
+    if (!reciprocal) return false;
+    double e = 0;
+    const auto rec = reciprocal_refit(data, opt, h, &e);
+    return rec && e < errors.back() && opt.stop_after_term(*rec);
+  };
+}
+
 // final_reciprocity: each structured answer refit with its terms reciprocal,
 // kept when lower on `data` (in parallel; a refit that fails to solve leaves
 // the answer as it was).
 void reciprocal_refits(const FitData& data, const SearchOptions& opt, SearchResult& r) {
-  if (!opt.final_reciprocity || opt.reciprocity || r.answers.empty()) return;
+  if (!reciprocal_answers_on(opt) || r.answers.empty()) return;
   const size_t J = r.answers.size();
   r.reciprocal_answers.assign(J, false);
   std::vector<std::shared_ptr<HomomorphicFactorization>> refits(J);
@@ -503,16 +544,7 @@ void reciprocal_refits(const FitData& data, const SearchOptions& opt, SearchResu
       static_cast<int64_t>(J),
       [&](int64_t i) {
         const size_t k = J - 1 - static_cast<size_t>(i);
-        if (!r.answers[k]) return;
-        std::vector<TermSpec> sp = specs_of(*r.answers[k]);
-        for (TermSpec& t : sp) t.reciprocal = true;
-        std::vector<double> err;
-        try {
-          refits[k] = fit_homomorphic(data, sp, refit_options(opt, static_cast<int>(sp.size())), "search", &err);
-          errors[k] = err.back();
-        } catch (const std::runtime_error&) {
-          refits[k] = nullptr;
-        }
+        if (r.answers[k]) refits[k] = reciprocal_refit(data, opt, *r.answers[k], &errors[k]);
       },
       opt.threads);
   for (size_t k = 0; k < J; ++k) {
@@ -534,7 +566,9 @@ SearchResult search_factorization(const FitData& data, const SearchOptions& opt)
   if (opt.strategy == "best") return best_of_both(data, opt);
   const double t0 = now_seconds();
   if (opt.search_samples == 0 || data.size() <= opt.search_samples) {
-    SearchResult r = search_on(data, opt);
+    SearchOptions so = opt;
+    if (opt.stop_after_term && reciprocal_answers_on(opt)) so.stop_after_term = answer_stop_rule(data, opt, false);
+    SearchResult r = search_on(data, so);
     r.search_samples = r.data_samples = data.size();
     reciprocal_refits(data, opt, r);
     r.seconds = now_seconds() - t0;
@@ -544,10 +578,7 @@ SearchResult search_factorization(const FitData& data, const SearchOptions& opt)
   SubsampleInfo info;
   const FitData sub = stratified_subsample(data, opt.search_samples, opt.seed, &info);
   SearchOptions so = opt;
-  if (opt.stop_after_term)  // the stopping rule judges the terms so far fitted on every sample
-    so.stop_after_term = [&](const HomomorphicFactorization& h) {
-      return opt.stop_after_term(*refit_on(data, opt, h, nullptr));
-    };
+  if (opt.stop_after_term) so.stop_after_term = answer_stop_rule(data, opt, true);
   SearchResult r = search_on(sub, so);
   refit_search_result(data, opt, r);
   reciprocal_refits(data, opt, r);

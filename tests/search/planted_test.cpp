@@ -779,6 +779,44 @@ TEST_CASE("structured search: final_reciprocity refits each answer with reciproc
   CHECK(r1.rel_mse_after_term[1] < 0.9 * r0.rel_mse_after_term[1]);
 }
 
+TEST_CASE("structured search: a stopping rule judges the answer final_reciprocity keeps") {
+  // A tolerance that the k-term answer's reciprocal refit meets, and the
+  // answer before it does not, ends the search at k terms with that refit as
+  // its answer (not one term later, as when the rule saw only the search's fit).
+  const BrdfPtr b = Catalogue::builtin().make("bluepaint");
+  const SampleSet s = sample_grid(*b, 8);
+  const FitData d(s, 1e-5);
+  SearchOptions opt = structured(3, 6);
+  opt.restarts = 2;
+  opt.threads = 2;
+  opt.final_reciprocity = true;
+  const LogTransform lt = LogTransform::of(s, 1e-5);
+  std::vector<std::pair<size_t, double>> seen;  // (terms, rel_mse) of what the rule is shown
+  opt.stop_after_term = [&](const HomomorphicFactorization& h) {
+    seen.emplace_back(h.terms().size(), evaluate_metrics(h, s, lt).rel_mse);
+    return false;
+  };
+  const SearchResult all = search_factorization(d, opt);
+  REQUIRE(all.rel_mse_after_term.size() == 3);
+  // After terms 1 and 2: the search's answer, then its reciprocal refit (lower here).
+  REQUIRE(seen.size() == 4);
+  CHECK(seen[2].first == 2);
+  CHECK(seen[3].first == 2);
+  INFO("2 terms: answer " << seen[2].second << ", reciprocal refit " << seen[3].second);
+  REQUIRE(seen[3].second < seen[2].second);
+  REQUIRE(seen[1].second > seen[2].second);
+  const double target = 0.5 * (seen[2].second + seen[3].second);
+  opt.stop_after_term = [&](const HomomorphicFactorization& h) { return evaluate_metrics(h, s, lt).rel_mse <= target; };
+  const SearchResult two = search_factorization(d, opt);
+  REQUIRE(two.rel_mse_after_term.size() == 2);
+  CHECK(two.reciprocal_answers.at(1));
+  CHECK(evaluate_metrics(*two.factorization, s, lt).rel_mse <= target);
+  CHECK(two.evaluations < all.evaluations);
+  // Without the reciprocal answers the same tolerance takes a third term.
+  opt.final_reciprocity = false;
+  CHECK(search_factorization(d, opt).rel_mse_after_term.size() == 3);
+}
+
 TEST_CASE("structured search: final_reciprocity keeps an answer whose reciprocal refit is higher") {
   // A planted two-plane BRDF is not reciprocal: its 2-term answer (the true
   // planes, at the floor) fits worse read through the conjugates too and
