@@ -17,6 +17,22 @@ using namespace bf_test;
 
 namespace {
 
+// Runs `body` (Python, with plot_results imported as p) and expects it to
+// print "ok": a probe of the plots' series naming.
+void check_plot_probe(const std::string& body) {
+  const std::string py = find_python(nullptr);
+  INFO("no python3 with matplotlib (scripts/install-deps.sh installs python3-matplotlib)");
+  REQUIRE(!py.empty());
+  ScratchDir tmp;
+  const std::string probe = "import sys; sys.path.insert(0, '" +
+                            fs::path(plot_script_path()).parent_path().string() +
+                            "'); import plot_results as p\n" + body + "print('ok')\n";
+  write_text(tmp / "probe.py", probe);
+  CHECK(std::system((py + " " + (tmp / "probe.py") + " > " + (tmp / "probe.txt") + " 2>&1").c_str()) == 0);
+  INFO(read_text(tmp / "probe.txt"));
+  CHECK(read_text(tmp / "probe.txt") == "ok\n");
+}
+
 // Small and fast, and of McCool's form p(wi) q(h) p(wo): the structured search
 // mixes wiwo and halfdiff terms on it when allowed to (the control below
 // checks that it does).
@@ -200,16 +216,10 @@ TEST_CASE("search parameterization: term_param either with an explicit parameter
 }
 
 TEST_CASE("search parameterization: the plots group a parameterization sweep by the asked value") {
-  const std::string py = find_python(nullptr);
-  INFO("no python3 with matplotlib (scripts/install-deps.sh installs python3-matplotlib)");
-  REQUIRE(!py.empty());
-  ScratchDir tmp;
   // Rows of one sweep whose terms read other points than asked (a results.csv
   // of a version that let the search choose, or a column of the terms' own):
   // still one series per asked value, never one per chosen set.
-  const std::string probe =
-      "import sys; sys.path.insert(0, '" + fs::path(plot_script_path()).parent_path().string() +
-      "'); import plot_results as p\n"
+  check_plot_probe(
       "rows = [\n"
       "  {'label': 's', 'parameterization': 'wiwo+halfdiff', 'term_parameterizations': 'wiwo+halfdiff',\n"
       "   'sweep': 'parameterization=wiwo terms=2'},\n"
@@ -225,25 +235,14 @@ TEST_CASE("search parameterization: the plots group a parameterization sweep by 
       "names = [p.series_name(r, {'terms'}) for r in rows]\n"
       "assert names[0] == names[1] and names[2] == names[3] and names[0] != names[2], names\n"
       "assert 'wiwo' in names[0] and 'halfdiff' in names[2], names\n"
-      "assert names[4] == names[5] and len(set(names)) == 3, names\n"
-      "print('ok')\n";
-  write_text(tmp / "probe.py", probe);
-  CHECK(std::system((py + " " + (tmp / "probe.py") + " > " + (tmp / "probe.txt") + " 2>&1").c_str()) == 0);
-  INFO(read_text(tmp / "probe.txt"));
-  CHECK(read_text(tmp / "probe.txt") == "ok\n");
+      "assert names[4] == names[5] and len(set(names)) == 3, names\n");
 }
 
 TEST_CASE("search parameterization: the plots split a reciprocity sweep by the asked value") {
-  const std::string py = find_python(nullptr);
-  INFO("no python3 with matplotlib (scripts/install-deps.sh installs python3-matplotlib)");
-  REQUIRE(!py.empty());
-  ScratchDir tmp;
   // thesis-bluepaint's sweep: reciprocity = [false, true]; the false run's
   // answers were refit with reciprocal terms (final_reciprocity), so its
   // column reads true too. Two series, not one drawn over the other.
-  const std::string probe =
-      "import sys; sys.path.insert(0, '" + fs::path(plot_script_path()).parent_path().string() +
-      "'); import plot_results as p\n"
+  check_plot_probe(
       "rows = [\n"
       "  {'label': 's', 'parameterization': 'wiwo', 'reciprocity': 'true',\n"
       "   'sweep': 'parameterization=wiwo reciprocity=false'},\n"
@@ -257,12 +256,7 @@ TEST_CASE("search parameterization: the plots split a reciprocity sweep by the a
       "names = [p.series_name(r, {'terms'}) for r in rows]\n"
       "assert len(set(names)) == 5, names\n"
       "assert names[1].endswith(' recip') and names[0].endswith('recip answers'), names\n"
-      "assert 'recip' not in names[2] and 'recip' not in names[4] and names[3].endswith(' recip'), names\n"
-      "print('ok')\n";
-  write_text(tmp / "probe.py", probe);
-  CHECK(std::system((py + " " + (tmp / "probe.py") + " > " + (tmp / "probe.txt") + " 2>&1").c_str()) == 0);
-  INFO(read_text(tmp / "probe.txt"));
-  CHECK(read_text(tmp / "probe.txt") == "ok\n");
+      "assert 'recip' not in names[2] and 'recip' not in names[4] and names[3].endswith(' recip'), names\n");
 }
 
 TEST_CASE("search parameterization: bench search follows the config's rule") {
