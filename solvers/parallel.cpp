@@ -16,29 +16,9 @@ int hardware_threads(int requested) {
 
 void parallel_for(int64_t n, const std::function<void(int64_t, int64_t)>& body, int threads) {
   if (n <= 0) return;
-  int64_t t = hardware_threads(threads);
-  t = std::min<int64_t>(t, n);
-  if (t == 1) {
-    body(0, n);
-    return;
-  }
-  std::exception_ptr error;
-  std::mutex error_mutex;
-  auto run = [&](int64_t k) {
-    const int64_t begin = n * k / t, end = n * (k + 1) / t;
-    try {
-      body(begin, end);
-    } catch (...) {
-      std::lock_guard<std::mutex> lock(error_mutex);
-      if (!error) error = std::current_exception();
-    }
-  };
-  std::vector<std::thread> pool;
-  pool.reserve(size_t(t - 1));
-  for (int64_t k = 1; k < t; ++k) pool.emplace_back(run, k);
-  run(0);
-  for (std::thread& th : pool) th.join();
-  if (error) std::rethrow_exception(error);
+  // One contiguous chunk per thread, run by the index loop below.
+  const int64_t t = std::min<int64_t>(hardware_threads(threads), n);
+  parallel_for_each(t, [&](int64_t k) { body(n * k / t, n * (k + 1) / t); }, static_cast<int>(t));
 }
 
 void parallel_for_each(int64_t n, const std::function<void(int64_t)>& body, int threads) {

@@ -328,9 +328,7 @@ class SearchKind final : public HomomorphicKind {
   }
   std::vector<KeySpec> keys() const override { return search_keys(); }
   bool seeded() const override { return true; }
-  std::string example() const override {
-    return "terms = 1\ntexture_size = 6\nrestarts = 1\nthreads = 1\n";
-  }
+  std::string example() const override { return "terms = 1\ntexture_size = 6\nrestarts = 1\nthreads = 1\n"; }
   std::vector<std::string> described() const override {
     return {"parameterization", "terms", "texture_size", "reciprocity", "restarts", "optimizer", "beam",
             "backfit_sweeps", "seed"};
