@@ -511,18 +511,23 @@ std::shared_ptr<HomomorphicFactorization> reciprocal_refit(const FitData& data, 
 // fitted on every sample (refit: a subsampled search's candidates are not),
 // and, with the reciprocal answers, also their reciprocal refit where it is
 // lower (the answer reciprocal_refits keeps). So a tolerance the refit meets
-// ends the search at that term, not one later.
+// ends the search at that term, not one later. Each of its fits adds one to
+// *fits (the search calls the rule from one thread, after each term).
 std::function<bool(const HomomorphicFactorization&)> answer_stop_rule(const FitData& data, const SearchOptions& opt,
-                                                                       bool refit) {
-  return [&data, &opt, refit](const HomomorphicFactorization& h) {
+                                                                       bool refit, int* fits) {
+  return [&data, &opt, refit, fits](const HomomorphicFactorization& h) {
     const bool reciprocal = reciprocal_answers_on(opt);
     std::vector<double> errors;
     std::shared_ptr<HomomorphicFactorization> fitted;
-    if (refit || reciprocal) fitted = refit_on(data, opt, h, &errors);
+    if (refit || reciprocal) {
+      fitted = refit_on(data, opt, h, &errors);
+      ++*fits;
+    }
     if (opt.stop_after_term(refit ? *fitted : h)) return true;
     if (!reciprocal) return false;
     double e = 0;
     const auto rec = reciprocal_refit(data, opt, h, &e);
+    ++*fits;
     return rec && e < errors.back() && opt.stop_after_term(*rec);
   };
 }
@@ -565,10 +570,14 @@ SearchResult search_factorization(const FitData& data, const SearchOptions& opt)
   opt.validate();
   if (opt.strategy == "best") return best_of_both(data, opt);
   const double t0 = now_seconds();
+  // The stopping rule's own fits (answer_stop_rule) count as the search's.
+  int rule_fits = 0;
   if (opt.search_samples == 0 || data.size() <= opt.search_samples) {
     SearchOptions so = opt;
-    if (opt.stop_after_term && reciprocal_answers_on(opt)) so.stop_after_term = answer_stop_rule(data, opt, false);
+    if (opt.stop_after_term && reciprocal_answers_on(opt))
+      so.stop_after_term = answer_stop_rule(data, opt, false, &rule_fits);
     SearchResult r = search_on(data, so);
+    r.evaluations += rule_fits;
     r.search_samples = r.data_samples = data.size();
     reciprocal_refits(data, opt, r);
     r.seconds = now_seconds() - t0;
@@ -578,8 +587,9 @@ SearchResult search_factorization(const FitData& data, const SearchOptions& opt)
   SubsampleInfo info;
   const FitData sub = stratified_subsample(data, opt.search_samples, opt.seed, &info);
   SearchOptions so = opt;
-  if (opt.stop_after_term) so.stop_after_term = answer_stop_rule(data, opt, true);
+  if (opt.stop_after_term) so.stop_after_term = answer_stop_rule(data, opt, true, &rule_fits);
   SearchResult r = search_on(sub, so);
+  r.evaluations += rule_fits;
   refit_search_result(data, opt, r);
   reciprocal_refits(data, opt, r);
   r.search_samples = info.samples;

@@ -805,6 +805,13 @@ TEST_CASE("structured search: a stopping rule judges the answer final_reciprocit
   INFO("2 terms: answer " << seen[2].second << ", reciprocal refit " << seen[3].second);
   REQUIRE(seen[3].second < seen[2].second);
   REQUIRE(seen[1].second > seen[2].second);
+  // The rule changes nothing in the search, and its own fits count: after
+  // terms 1 and 2 the answer again and its reciprocal refit (2 fits each).
+  SearchOptions no_rule = opt;
+  no_rule.stop_after_term = nullptr;
+  const SearchResult none = search_factorization(d, no_rule);
+  CHECK(none.rel_mse_after_term == all.rel_mse_after_term);
+  CHECK(all.evaluations == none.evaluations + 4);
   const double target = 0.5 * (seen[2].second + seen[3].second);
   opt.stop_after_term = [&](const HomomorphicFactorization& h) { return evaluate_metrics(h, s, lt).rel_mse <= target; };
   const SearchResult two = search_factorization(d, opt);
