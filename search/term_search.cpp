@@ -473,12 +473,14 @@ void refit_search_result(const FitData& data, const SearchOptions& opt, SearchRe
   if (r.answers.empty()) {  // greedy: its k-term answers are the schedule's prefixes
     r.factorization = refit_on(data, opt, *r.factorization, &errors);
     r.rel_mse_after_term = errors;
+    ++r.evaluations;
     return;
   }
   // Structured: every k-term answer on its own.
   for (size_t k = 0; k < r.answers.size(); ++k) {
     if (!r.answers[k]) continue;
     r.answers[k] = refit_on(data, opt, *r.answers[k], &errors);
+    ++r.evaluations;
     r.rel_mse_after_term[k] = errors.back();
   }
   r.factorization = r.answers.back();

@@ -179,8 +179,9 @@ SearchResult search_factorization(const FitData& data, const SearchOptions& opt)
 // Refits r's answers (or, greedy, its factorization) on `data` at
 // texture_size as the search refits them (greedy: the schedule; structured:
 // all terms solved jointly with final_joint), replacing factorization, answers
-// and rel_mse_after_term. What search_factorization does after a search on a
-// subsample; on the samples the search ran on it reproduces r.
+// and rel_mse_after_term; each refit adds one to r.evaluations. What
+// search_factorization does after a search on a subsample; on the samples the
+// search ran on it reproduces r.
 void refit_search_result(const FitData& data, const SearchOptions& opt, SearchResult& r);
 
 // The objective of one candidate rotation for the next term (exposed for

@@ -151,5 +151,7 @@ TEST_CASE("search subsample: refit_search_result on the searched samples reprodu
     REQUIRE(again.rel_mse_after_term.size() == r.rel_mse_after_term.size());
     for (size_t k = 0; k < r.rel_mse_after_term.size(); ++k)
       CHECK(again.rel_mse_after_term[k] == Approx(r.rel_mse_after_term[k]).epsilon(1e-12));
+    // Its fits count: one (greedy's schedule) or one per k-term answer.
+    CHECK(again.evaluations == r.evaluations + (strategy == "greedy" ? 1 : static_cast<int>(r.answers.size())));
   }
 }
