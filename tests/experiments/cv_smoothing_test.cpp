@@ -46,7 +46,9 @@ TEST_CASE("cv: smoothing = cv picks the middle value that a noisy smooth BRDF ne
   const std::string csv = noisy_csv(tmp);
   for (const std::string& exp : {std::string("holdout = 0.2\n"), std::string("folds = 3\n")}) {
     INFO(exp);
-    const std::string out = tmp / ("o" + std::to_string(exp.size()));
+    std::string name = "o";  // not "o" + std::to_string(...): GCC 12 warns falsely there (-Wrestrict)
+    name += std::to_string(exp.size());
+    const std::string out = tmp / name;
     run_quiet(write_text(out + ".toml", config(csv, exp)), out);
     const auto rows = read_results_csv(out + "/results.csv");
     REQUIRE(rows.size() == 1);
