@@ -29,7 +29,10 @@ SAMPLERS = ["cosine", "tabulated", "model", "cosine+light", "tabulated+light", "
 def mc_variance(exe, brdf, factors, env):
     cmd = [exe, "mc-variance", "--brdf", brdf, "--approx", factors, "--environment", env,
            "--spp", "64", "--size", "32", "--mis", "--view-phi-bins", "1"]
-    out = subprocess.run(cmd, check=True, capture_output=True, text=True).stdout
+    done = subprocess.run(cmd, capture_output=True, text=True)
+    if done.returncode != 0:
+        sys.exit(f"mc-variance-table: `{' '.join(cmd)}` exited {done.returncode}: {done.stderr.strip()}")
+    out = done.stdout
     rows = {}
     for line in out.splitlines():
         f = line.split()
@@ -56,6 +59,8 @@ def main():
     ap.add_argument("--exe", default="build/experiments/brdf-factor")
     ap.add_argument("--environment", default="data/env/sky.exr")
     a = ap.parse_args()
+    if not os.path.isfile(a.exe):
+        sys.exit(f"mc-variance-table: expected the brdf-factor executable at {a.exe} (--exe), found no such file")
     path = os.path.join(a.out, "results.csv")
     if not os.path.isfile(path):
         sys.exit(f"mc-variance-table: expected {path}, found no such file")
@@ -65,9 +70,10 @@ def main():
     print("|---|---|---|---|---|---|---|---|---|")
     for name, brdf, label in BRDFS:
         mine = [r for r in runs if r["brdf"] == name]
+        if sorted(r["parameterization"] for r in mine) != ["halfdiff", "wiwo"]:
+            sys.exit(f"mc-variance-table: {path}: expected 2 runs of {name} (wiwo, halfdiff), found "
+                     f"{[r['parameterization'] for r in mine]}")
         mine.sort(key=lambda r: ["wiwo", "halfdiff"].index(r["parameterization"]))
-        if len(mine) != 2:
-            sys.exit(f"mc-variance-table: {path}: expected 2 runs of {name} (wiwo, halfdiff), found {len(mine)}")
         for i, r in enumerate(mine):
             if r["status"] != "ok":
                 sys.exit(f"mc-variance-table: {path}: run {r['run_id']} has status {r['status']}")
