@@ -2,7 +2,9 @@
 # Builds the library, CLI and tests with AddressSanitizer + UndefinedBehaviorSanitizer
 # (-DBRDF_FACTOR_SANITIZE=ON: gcc, -O1, every UBSan finding fatal via
 # -fno-sanitize-recover=all) into build-asan/ and runs the default test suite
-# (ctest -LE slow) under them. Any finding makes a test, and so this script, fail.
+# under them, but for the tests tagged [heavy] (ctest -LE 'slow|heavy': repeats
+# of code paths the other tests run; docs/testing.md). Any finding makes a
+# test, and so this script, fail.
 #   scripts/test-sanitize.sh              every default test
 #   scripts/test-sanitize.sh REGEX        only tests whose name matches (ctest -R)
 # Build dir: $BF_ASAN_BUILD_DIR (default build-asan). Needs only the default
@@ -24,7 +26,7 @@ export UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1"
 # The whole suite: CTest must register exactly the Catch2 test cases.
 [ -z "${1:-}" ] && bash scripts/check-test-count.sh "$build"
 cd "$build"
-args=(-LE slow --no-tests=error --output-on-failure -j "$(nproc)" --timeout 1800)
+args=(-LE 'slow|heavy' --no-tests=error --output-on-failure -j "$(nproc)" --timeout 1800)
 [ -n "${1:-}" ] && args+=(-R "$1")
 status=0
 ctest "${args[@]}" || status=$?

@@ -300,39 +300,57 @@ TEST_CASE("structure: the seed planes of planted member 12 (halfdiff, 16^4 grid)
   CHECK(sp.off_block < 0.01);
 }
 
-TEST_CASE("structured search: a planted two-plane BRDF ends near the floor, the greedy search does not") {
-  // Grid 10, texture 8 (small, so the default suite stays fast). Bound: 1.5x the
-  // floor (measured 0.4x..0.9x on members 0..2: the search may also turn the
-  // texture axes inside the true planes, which the floor does not).
+namespace {
+
+// Planted member 0 (wiwo, two planes), grid 10, texture 8 (small, so the
+// default suite stays fast), searched by the structured and the greedy search.
+struct TwoPlaneCase {
   const PlantedProductBrdf b = planted_rotation_brdf(0, 2, Parameterization::WiWo);
   const SampleSet s = sample_grid(b, 10);
-  const FitData d(s, 1e-5);
-  const double fl = floor_error(b, d, 8);
+  const FitData d{s, 1e-5};
   const SearchResult r = search_factorization(d, structured(2, 8));
-  SearchOptions g = structured(2, 8);
-  g.strategy = "greedy";
-  const SearchResult rg = search_factorization(d, g);
-  INFO("floor " << fl << ", structured " << r.rel_mse_after_term.back() << " (" << r.evaluations
-                << " fits), greedy " << rg.rel_mse_after_term.back() << " (" << rg.evaluations << " fits)");
-  CHECK(r.rel_mse_after_term.back() <= 1.5 * fl);
-  CHECK(rg.rel_mse_after_term.back() > 1.5 * fl);  // the trap this search exists for
-  CHECK(r.strategy == "structured");
-  CHECK(rg.strategy == "greedy");
+  const SearchResult rg = search_factorization(d, greedy());
+  static SearchOptions greedy() {
+    SearchOptions g = structured(2, 8);
+    g.strategy = "greedy";
+    return g;
+  }
+};
+
+}  // namespace
+
+TEST_CASE("structured search: a planted two-plane BRDF ends near the floor, the greedy search does not") {
+  // Bound: 1.5x the floor (measured 0.4x..0.9x on members 0..2: the search
+  // may also turn the texture axes inside the true planes, which the floor
+  // does not).
+  const TwoPlaneCase c;
+  const double fl = floor_error(c.b, c.d, 8);
+  INFO("floor " << fl << ", structured " << c.r.rel_mse_after_term.back() << " (" << c.r.evaluations
+                << " fits), greedy " << c.rg.rel_mse_after_term.back() << " (" << c.rg.evaluations << " fits)");
+  CHECK(c.r.rel_mse_after_term.back() <= 1.5 * fl);
+  CHECK(c.rg.rel_mse_after_term.back() > 1.5 * fl);  // the trap this search exists for
+  CHECK(c.r.strategy == "structured");
+  CHECK(c.rg.strategy == "greedy");
+}
+
+TEST_CASE("structured search: best keeps the structured answer whole on a planted two-plane BRDF", "[heavy]") {
+  const TwoPlaneCase c;
   // strategy = "best" runs both and keeps the structured answer here, whole.
   SearchOptions both = structured(2, 8);
   both.strategy = "best";
-  const SearchResult rb = search_factorization(d, both);
+  const SearchResult rb = search_factorization(c.d, both);
   CHECK(rb.strategy == "structured");
-  CHECK(rb.rel_mse_after_term == r.rel_mse_after_term);
-  CHECK(rb.evaluations == r.evaluations + rg.evaluations);
+  CHECK(rb.rel_mse_after_term == c.r.rel_mse_after_term);
+  CHECK(rb.evaluations == c.r.evaluations + c.rg.evaluations);
   CHECK(rb.factorization->eval(Vec3(0.3, 0.1, 0.95).normalized(), Vec3(-0.2, 0.4, 0.89).normalized())
-            .isApprox(r.factorization->eval(Vec3(0.3, 0.1, 0.95).normalized(), Vec3(-0.2, 0.4, 0.89).normalized())));
+            .isApprox(c.r.factorization->eval(Vec3(0.3, 0.1, 0.95).normalized(), Vec3(-0.2, 0.4, 0.89).normalized())));
   // With a stopping rule (a tolerance) it is the greedy search alone.
+  SearchOptions g = TwoPlaneCase::greedy();
   both.stop_after_term = [](const HomomorphicFactorization&) { return false; };
   g.stop_after_term = both.stop_after_term;
-  const SearchResult rt = search_factorization(d, both);
+  const SearchResult rt = search_factorization(c.d, both);
   CHECK(rt.strategy == "greedy");
-  CHECK(rt.rel_mse_after_term == search_factorization(d, g).rel_mse_after_term);
+  CHECK(rt.rel_mse_after_term == search_factorization(c.d, g).rel_mse_after_term);
 }
 
 TEST_CASE("structured search: deterministic for a seed, whatever the thread count") {
@@ -496,11 +514,18 @@ TEST_CASE("structured search: a 2-term pair across parameterizations finds both 
   // Member 1 ended with both terms in wiwo on two wrong planes (2.21x, 0.99
   // and 0.83 off), which no one-term move leaves; the mixed pair's random
   // restarts (reseed_mixed_pair) reach both true planes: 0.60x, within 0.001.
-  for (int member : {0, 1, 3}) check_pair(member, Parameterization::HalfDiff, 10, 8, 1.2, 0.01);
+  // Members 1 and 3 at texture 8: the [heavy] test below.
+  check_pair(0, Parameterization::HalfDiff, 10, 8, 1.2, 0.01);
   // At texture 12 those restarts search at texture 8 (half the search's,
   // kPairRestartMinTexture) and the pair they keep is read and polished at
   // 12: member 1 ends at 0.90x (14.7x, both terms in wiwo, without them).
   check_pair(1, Parameterization::HalfDiff, 10, 12, 1.2, 0.01);
+}
+
+TEST_CASE("structured search: more 2-term pairs across parameterizations find both planes", "[heavy]") {
+  // Members 1 and 3 of the test above at texture 8 (the one-term move and
+  // the mixed pair's restarts, which that test runs too).
+  for (int member : {1, 3}) check_pair(member, Parameterization::HalfDiff, 10, 8, 1.2, 0.01);
 }
 
 TEST_CASE("structured search: a 2-term answer in one parameterization is restarted in that mix too") {
@@ -779,49 +804,79 @@ TEST_CASE("structured search: final_reciprocity refits each answer with reciproc
   CHECK(r1.rel_mse_after_term[1] < 0.9 * r0.rel_mse_after_term[1]);
 }
 
+namespace {
+
+// Bluepaint, grid 8, a 3-term structured search (texture 6, 2 restarts) with
+// the reciprocal answers, and a stopping rule that records what it is shown
+// and never stops the search.
+struct StopRuleCase {
+  const BrdfPtr b = Catalogue::builtin().make("bluepaint");
+  const SampleSet s = sample_grid(*b, 8);
+  const FitData d{s, 1e-5};
+  const LogTransform lt = LogTransform::of(s, 1e-5);
+  SearchOptions opt = options();
+  std::vector<std::pair<size_t, double>> seen;  // (terms, rel_mse) of what the rule is shown
+  SearchResult all;
+
+  StopRuleCase() {
+    SearchOptions o = opt;
+    o.stop_after_term = [this](const HomomorphicFactorization& h) {
+      seen.emplace_back(h.terms().size(), evaluate_metrics(h, s, lt).rel_mse);
+      return false;
+    };
+    all = search_factorization(d, o);
+  }
+  static SearchOptions options() {
+    SearchOptions o = structured(3, 6);
+    o.restarts = 2;
+    o.threads = 2;
+    o.final_reciprocity = true;
+    return o;
+  }
+  // A tolerance between the 2-term answer and its reciprocal refit (lower here).
+  double target() const { return 0.5 * (seen.at(2).second + seen.at(3).second); }
+};
+
+}  // namespace
+
 TEST_CASE("structured search: a stopping rule judges the answer final_reciprocity keeps") {
   // A tolerance that the k-term answer's reciprocal refit meets, and the
   // answer before it does not, ends the search at k terms with that refit as
   // its answer (not one term later, as when the rule saw only the search's fit).
-  const BrdfPtr b = Catalogue::builtin().make("bluepaint");
-  const SampleSet s = sample_grid(*b, 8);
-  const FitData d(s, 1e-5);
-  SearchOptions opt = structured(3, 6);
-  opt.restarts = 2;
-  opt.threads = 2;
-  opt.final_reciprocity = true;
-  const LogTransform lt = LogTransform::of(s, 1e-5);
-  std::vector<std::pair<size_t, double>> seen;  // (terms, rel_mse) of what the rule is shown
-  opt.stop_after_term = [&](const HomomorphicFactorization& h) {
-    seen.emplace_back(h.terms().size(), evaluate_metrics(h, s, lt).rel_mse);
-    return false;
-  };
-  const SearchResult all = search_factorization(d, opt);
-  REQUIRE(all.rel_mse_after_term.size() == 3);
+  StopRuleCase c;
+  REQUIRE(c.all.rel_mse_after_term.size() == 3);
   // After terms 1 and 2: the search's answer, then its reciprocal refit (lower here).
-  REQUIRE(seen.size() == 4);
-  CHECK(seen[2].first == 2);
-  CHECK(seen[3].first == 2);
-  INFO("2 terms: answer " << seen[2].second << ", reciprocal refit " << seen[3].second);
-  REQUIRE(seen[3].second < seen[2].second);
-  REQUIRE(seen[1].second > seen[2].second);
-  // The rule changes nothing in the search, and its own fits count: after
-  // terms 1 and 2 the answer again and its reciprocal refit (2 fits each).
-  SearchOptions no_rule = opt;
-  no_rule.stop_after_term = nullptr;
-  const SearchResult none = search_factorization(d, no_rule);
-  CHECK(none.rel_mse_after_term == all.rel_mse_after_term);
-  CHECK(all.evaluations == none.evaluations + 4);
-  const double target = 0.5 * (seen[2].second + seen[3].second);
-  opt.stop_after_term = [&](const HomomorphicFactorization& h) { return evaluate_metrics(h, s, lt).rel_mse <= target; };
-  const SearchResult two = search_factorization(d, opt);
+  REQUIRE(c.seen.size() == 4);
+  CHECK(c.seen[2].first == 2);
+  CHECK(c.seen[3].first == 2);
+  INFO("2 terms: answer " << c.seen[2].second << ", reciprocal refit " << c.seen[3].second);
+  REQUIRE(c.seen[3].second < c.seen[2].second);
+  REQUIRE(c.seen[1].second > c.seen[2].second);
+  const double target = c.target();
+  SearchOptions opt = c.opt;
+  opt.stop_after_term = [&](const HomomorphicFactorization& h) { return evaluate_metrics(h, c.s, c.lt).rel_mse <= target; };
+  const SearchResult two = search_factorization(c.d, opt);
   REQUIRE(two.rel_mse_after_term.size() == 2);
   CHECK(two.reciprocal_answers.at(1));
-  CHECK(evaluate_metrics(*two.factorization, s, lt).rel_mse <= target);
-  CHECK(two.evaluations < all.evaluations);
-  // Without the reciprocal answers the same tolerance takes a third term.
+  CHECK(evaluate_metrics(*two.factorization, c.s, c.lt).rel_mse <= target);
+  CHECK(two.evaluations < c.all.evaluations);
+}
+
+TEST_CASE("structured search: a stopping rule changes nothing in the search and its own fits count", "[heavy]") {
+  StopRuleCase c;
+  REQUIRE(c.seen.size() == 4);
+  // The rule changes nothing in the search, and its own fits count: after
+  // terms 1 and 2 the answer again and its reciprocal refit (2 fits each).
+  const SearchResult none = search_factorization(c.d, c.opt);
+  CHECK(none.rel_mse_after_term == c.all.rel_mse_after_term);
+  CHECK(c.all.evaluations == none.evaluations + 4);
+  // Without the reciprocal answers the tolerance the 2-term reciprocal
+  // refit meets takes a third term.
+  const double target = c.target();
+  SearchOptions opt = c.opt;
   opt.final_reciprocity = false;
-  CHECK(search_factorization(d, opt).rel_mse_after_term.size() == 3);
+  opt.stop_after_term = [&](const HomomorphicFactorization& h) { return evaluate_metrics(h, c.s, c.lt).rel_mse <= target; };
+  CHECK(search_factorization(c.d, opt).rel_mse_after_term.size() == 3);
 }
 
 TEST_CASE("structured search: final_reciprocity keeps an answer whose reciprocal refit is higher") {
