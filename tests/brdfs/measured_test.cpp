@@ -35,7 +35,7 @@ std::string cornell(const std::string& name) {
   return data_dir() + "/cornell/" + name;
 }
 
-const auto run_cli = bf_test::run_cli_stderr;
+using bf_test::run_cli_stderr;
 
 double deg(double d) {
   return d * M_PI / 180.0;
@@ -486,13 +486,13 @@ TEST_CASE("cli: a bad measured file exits 2 with one line and writes nothing") {
   TempDir d("cli_measured");
   const std::string out = d.file("s.csv");
   std::string err;
-  CHECK(run_cli("sample --brdf " + bad("astm_nan.astm") + " --grid 4 --out " + out, &err) == 2);
+  CHECK(run_cli_stderr("sample --brdf " + bad("astm_nan.astm") + " --grid 4 --out " + out, &err) == 2);
   CHECK_THAT(err, Contains("brdf-factor: ") && Contains("astm_nan.astm:7: column 20 (550nm)"));
   CHECK(std::count(err.begin(), err.end(), '\n') == 1);
   CHECK_FALSE(fs::exists(out));
-  CHECK(run_cli("eval --brdf " + bad("brdf_truncated.brdf") + " --wi 0,0,1 --wo 0,0,1", &err) == 2);
+  CHECK(run_cli_stderr("eval --brdf " + bad("brdf_truncated.brdf") + " --wi 0,0,1 --wo 0,0,1", &err) == 2);
   CHECK_THAT(err, Contains("truncated file?"));
-  CHECK(run_cli("eval --brdf cayman:band=550 --wi 0,0,1 --wo 0,0,1", &err) == 0);
+  CHECK(run_cli_stderr("eval --brdf cayman:band=550 --wi 0,0,1 --wo 0,0,1", &err) == 0);
 }
 
 TEST_CASE("spectral: the gamut mapping keeps every channel at the floor fraction of the luminance") {

@@ -29,7 +29,7 @@ namespace fs = std::filesystem;
 using bf_test::slurp;
 using bf_test::TempDir;
 
-const auto run_cli = bf_test::run_cli_stderr;
+using bf_test::run_cli_stderr;
 
 // A MERL-like file with the given header and `doubles` payload values (all
 // `fill`, little-endian on the little-endian hosts we build on).
@@ -56,7 +56,7 @@ class SmoothBrdf final : public Brdf {
   std::string to_string() const override { return "smooth"; }
 };
 
-double deg(double d) {
+double merl_deg(double d) {
   return d * M_PI / 180.0;
 }
 
@@ -111,13 +111,13 @@ TEST_CASE("merl: bin indices follow the reference, centres map to their bins") {
   CHECK(merl_theta_h_index(-1.0) == 0);
   CHECK(merl_theta_h_index(M_PI / 2) == 89);
   // Non-linear theta_h: bin 1 starts at (1/90)^2 * 90 deg = 0.0111 deg.
-  CHECK(merl_theta_h_index(deg(0.0110)) == 0);
-  CHECK(merl_theta_h_index(deg(0.0112)) == 1);
-  CHECK(merl_theta_h_index(deg(22.5)) == 45);  // sqrt(1/4) * 90
-  CHECK(merl_theta_d_index(deg(45.5)) == 45);
+  CHECK(merl_theta_h_index(merl_deg(0.0110)) == 0);
+  CHECK(merl_theta_h_index(merl_deg(0.0112)) == 1);
+  CHECK(merl_theta_h_index(merl_deg(22.5)) == 45);  // sqrt(1/4) * 90
+  CHECK(merl_theta_d_index(merl_deg(45.5)) == 45);
   CHECK(merl_theta_d_index(M_PI) == 89);
-  CHECK(merl_phi_d_index(deg(10.2)) == 10);
-  CHECK(merl_phi_d_index(deg(10.2) - M_PI) == 10);  // folded by pi
+  CHECK(merl_phi_d_index(merl_deg(10.2)) == 10);
+  CHECK(merl_phi_d_index(merl_deg(10.2) - M_PI) == 10);  // folded by pi
   CHECK(merl_phi_d_index(M_PI) == 0);               // pi == 0 after folding
   CHECK(merl_phi_d_index(std::nan("")) == 0);
   for (int i = 0; i < 90; ++i) {
@@ -387,7 +387,7 @@ TEST_CASE("cli: export-merl writes a readable 34,992,012-byte file, atomically")
   TempDir d("cli_merl");
   const std::string out = d.file("lambert.binary");
   std::string err;
-  REQUIRE(run_cli("export-merl --brdf lambert:kd=0.3 --out " + out, &err) == 0);
+  REQUIRE(run_cli_stderr("export-merl --brdf lambert:kd=0.3 --out " + out, &err) == 0);
   CHECK(fs::file_size(out) == kMerlFileBytes);
   CHECK_FALSE(fs::exists(out + ".tmp"));
   const BrdfPtr b = Catalogue::builtin().make(out);
@@ -395,25 +395,25 @@ TEST_CASE("cli: export-merl writes a readable 34,992,012-byte file, atomically")
             .isApprox(Rgb::Constant(0.3 / M_PI), 1e-14));
   // Failures exit 2, write nothing, and leave an existing file untouched.
   const std::string missing = d.file("nothing.binary");
-  CHECK(run_cli("export-merl --brdf nope --out " + missing, &err) == 2);
+  CHECK(run_cli_stderr("export-merl --brdf nope --out " + missing, &err) == 2);
   CHECK_THAT(err, Contains("brdf-factor: --brdf: unknown BRDF 'nope'"));
   CHECK_FALSE(fs::exists(missing));
   // Every MERL file has the same size: compare the bytes, not the size.
   const std::string before = slurp(out);
   REQUIRE(before.size() == kMerlFileBytes);
-  CHECK(run_cli("export-merl --brdf " + std::string(BF_TEST_DATA_DIR) +
+  CHECK(run_cli_stderr("export-merl --brdf " + std::string(BF_TEST_DATA_DIR) +
                     "/measured/astm_degrees.astm --out " + out,
                 &err) == 2);
   CHECK_THAT(err, Contains("(degrees?"));
   CHECK(slurp(out) == before);
   // A successful export of another BRDF does change the bytes (the comparison
   // can fail), through a rename that leaves no temporary behind.
-  REQUIRE(run_cli("export-merl --brdf lambert:kd=0.5 --out " + out, &err) == 0);
+  REQUIRE(run_cli_stderr("export-merl --brdf lambert:kd=0.5 --out " + out, &err) == 0);
   CHECK(slurp(out) != before);
   size_t entries = 0;
   for ([[maybe_unused]] const auto& e : fs::directory_iterator(d.path)) ++entries;
   CHECK(entries == 1);  // no temporary left beside it
-  CHECK(run_cli("export-merl --brdf lambert --out " + d.file("no/such/dir/x.binary"), &err) == 2);
+  CHECK(run_cli_stderr("export-merl --brdf lambert --out " + d.file("no/such/dir/x.binary"), &err) == 2);
   CHECK_THAT(err, Contains("cannot open"));
 }
 

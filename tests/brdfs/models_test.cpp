@@ -59,7 +59,7 @@ std::vector<Vec3> probe_directions() {
   return d;
 }
 
-Vec3 random_upper(std::mt19937_64& rng) {
+Vec3 random_upper_dir(std::mt19937_64& rng) {
   std::uniform_real_distribution<double> U(0.0, 1.0);
   return from_spherical(std::acos(U(rng)), 2.0 * M_PI * U(rng));
 }
@@ -185,7 +185,7 @@ TEST_CASE("catalogue: BRDFs reporting reciprocal() satisfy f(wi, wo) = f(wo, wi)
   const std::vector<Vec3> probes = probe_directions();
   for (size_t i = 0; i < probes.size(); i += 3)
     for (size_t j = 1; j < probes.size(); j += 4) pairs.push_back({probes[i], probes[j]});
-  for (int k = 0; k < 300; ++k) pairs.push_back({random_upper(rng), random_upper(rng)});
+  for (int k = 0; k < 300; ++k) pairs.push_back({random_upper_dir(rng), random_upper_dir(rng)});
   int tested = 0;
   for (const Entry& e : catalogue_entries()) {
     if (!e.brdf->reciprocal()) continue;
@@ -202,7 +202,7 @@ TEST_CASE("catalogue: BRDFs reporting reciprocal() satisfy f(wi, wo) = f(wo, wi)
 TEST_CASE("catalogue: isotropic BRDFs are invariant under a common rotation about n") {
   std::mt19937_64 rng(9);
   std::vector<std::pair<Vec3, Vec3>> pairs;
-  for (int k = 0; k < 200; ++k) pairs.push_back({random_upper(rng), random_upper(rng)});
+  for (int k = 0; k < 200; ++k) pairs.push_back({random_upper_dir(rng), random_upper_dir(rng)});
   pairs.push_back({in_plane(kGrazing, 0.2), in_plane(kGrazing, 0.2 + M_PI)});
   pairs.push_back({in_plane(0.0), in_plane(0.0)});
   std::set<std::string> checked;
@@ -327,7 +327,7 @@ TEST_CASE("catalogue: to_string of every analytic model is a spec that rebuilds 
     const BrdfPtr b = cat.make(spec);
     CHECK(b->to_string() == s);
     for (int k = 0; k < 20; ++k) {
-      const Vec3 wi = random_upper(rng), wo = random_upper(rng);
+      const Vec3 wi = random_upper_dir(rng), wo = random_upper_dir(rng);
       CHECK((b->eval(wi, wo) == e.brdf->eval(wi, wo)).all());
     }
   }
@@ -339,7 +339,7 @@ TEST_CASE("catalogue: to_string of every analytic model is a spec that rebuilds 
 TEST_CASE("lambert: f = kd / pi at any pair") {
   std::mt19937_64 rng(1);
   for (int k = 0; k < 50; ++k) {
-    const Rgb f = eval("lambert:kd=0.1/0.2/0.3", random_upper(rng), random_upper(rng));
+    const Rgb f = eval("lambert:kd=0.1/0.2/0.3", random_upper_dir(rng), random_upper_dir(rng));
     CHECK(rel_equal(f, Rgb(0.1, 0.2, 0.3) / M_PI, 1e-15));
   }
 }

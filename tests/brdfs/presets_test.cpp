@@ -19,7 +19,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-constexpr double kDeg = M_PI / 180.0;
+constexpr double kPresetDeg = M_PI / 180.0;
 
 // pbrt-v1 Lafortune::f with bluepaint's numbers, typed from
 // pbrt_v1_lafortune_materials.csv (per channel):
@@ -49,14 +49,14 @@ Rgb bluepaint_by_hand(const Vec3& wi, const Vec3& wo) {
 // Pairs: normal, retro-reflective (wi = wo) at two angles, mirror, generic, grazing.
 std::vector<std::pair<Vec3, Vec3>> test_pairs() {
   return {{from_spherical(0, 0), from_spherical(0, 0)},
-          {from_spherical(60 * kDeg, 0.5), from_spherical(60 * kDeg, 0.5)},
-          {from_spherical(80 * kDeg, 2.0), from_spherical(80 * kDeg, 2.0)},
-          {from_spherical(35 * kDeg, 1.0), from_spherical(35 * kDeg, 1.0 + M_PI)},
-          {from_spherical(20 * kDeg, 0.3), from_spherical(55 * kDeg, 2.1)},
-          {from_spherical(89.99 * kDeg, 0.0), from_spherical(70 * kDeg, M_PI)}};
+          {from_spherical(60 * kPresetDeg, 0.5), from_spherical(60 * kPresetDeg, 0.5)},
+          {from_spherical(80 * kPresetDeg, 2.0), from_spherical(80 * kPresetDeg, 2.0)},
+          {from_spherical(35 * kPresetDeg, 1.0), from_spherical(35 * kPresetDeg, 1.0 + M_PI)},
+          {from_spherical(20 * kPresetDeg, 0.3), from_spherical(55 * kPresetDeg, 2.1)},
+          {from_spherical(89.99 * kPresetDeg, 0.0), from_spherical(70 * kPresetDeg, M_PI)}};
 }
 
-bool rel_equal(const Rgb& a, const Rgb& b, double tol) {
+bool rel_equal_rgb(const Rgb& a, const Rgb& b, double tol) {
   return ((a - b).abs() <= tol * a.abs().max(b.abs())).all();
 }
 
@@ -65,16 +65,16 @@ std::string params_dir() {
 }
 
 // A scratch folder under the system temp dir, removed at scope exit.
-struct TempDir {
+struct PresetDir {
   fs::path path;
-  TempDir() {
+  PresetDir() {
     static int counter = 0;
     path = fs::temp_directory_path() /
            ("bf-presets-test-" + std::to_string(::getpid()) + "-" + std::to_string(++counter));
     fs::remove_all(path);
     fs::create_directories(path);
   }
-  ~TempDir() { fs::remove_all(path); }
+  ~PresetDir() { fs::remove_all(path); }
   void write(const std::string& name, const std::string& text) const {
     std::ofstream(path / name) << text;
   }
@@ -126,15 +126,15 @@ TEST_CASE("presets: pbrt-v1 and Ngan presets exist when the data folder is prese
 TEST_CASE("presets: bluepaint evaluates pbrt-v1's Lafortune::f exactly") {
   const BrdfPtr b = Catalogue::builtin().make("bluepaint");
   // wi = wo = n by hand: rho_d/pi + Cz0^n0 + Cz1^n1 + Cz2^n2.
-  CHECK(rel_equal(b->eval(Vec3(0, 0, 1), Vec3(0, 0, 1)),
+  CHECK(rel_equal_rgb(b->eval(Vec3(0, 0, 1), Vec3(0, 0, 1)),
                   Rgb(0.10699103296563059, 0.13488097049596426, 0.24837474482344285), 1e-14));
   for (const auto& [wi, wo] : test_pairs()) {
     INFO("wi = " << wi.transpose() << ", wo = " << wo.transpose());
-    CHECK(rel_equal(b->eval(wi, wo), bluepaint_by_hand(wi, wo), 1e-13));
-    CHECK(rel_equal(b->eval(wo, wi), bluepaint_by_hand(wi, wo), 1e-13));
+    CHECK(rel_equal_rgb(b->eval(wi, wo), bluepaint_by_hand(wi, wo), 1e-13));
+    CHECK(rel_equal_rgb(b->eval(wo, wi), bluepaint_by_hand(wi, wo), 1e-13));
   }
   // Retro-reflection: lobe 0 (Cxy > 0) contributes v0^n0 ~ 0.03 at wi = wo.
-  const Vec3 w = from_spherical(60 * kDeg, 0.5);
+  const Vec3 w = from_spherical(60 * kPresetDeg, 0.5);
   const double v0 = 0.870567 * (w.x() * w.x() + w.y() * w.y()) + 0.803624 * w.z() * w.z();
   CHECK(std::pow(v0, 21.820103) > 0.02);
   CHECK(b->eval(w, w)[0] >= (0.3094 / M_PI + std::pow(v0, 21.820103)) * (1 - 1e-12));
@@ -155,7 +155,7 @@ TEST_CASE("presets: brdf-factor eval --brdf bluepaint matches pbrt-v1's formula"
     REQUIRE(status == 0);
     REQUIRE(got == 3);
     // The CLI prints 10 significant digits.
-    CHECK(rel_equal(Rgb(r, g, b), bluepaint_by_hand(wi, wo), 1e-9));
+    CHECK(rel_equal_rgb(Rgb(r, g, b), bluepaint_by_hand(wi, wo), 1e-9));
   }
 }
 
@@ -166,19 +166,19 @@ TEST_CASE("presets: Ngan 2005 tables evaluate as data/params/README.md states") 
     return;
   }
   // blue-acrylic rows, typed from the CSVs. Mirror pair at 30 deg: h = n.
-  const double t = 30 * kDeg, c = std::cos(t);
+  const double t = 30 * kPresetDeg, c = std::cos(t);
   const Vec3 wi = from_spherical(t, 0.4), wo = from_spherical(t, 0.4 + M_PI);
   auto schlick = [](double f0, double cd) { return f0 + (1 - f0) * std::pow(1 - cd, 5); };
   {
     const Rgb kd(0.0138, 0.0326, 0.0636), rho(0.00774, 0.00547, 0.00339);
     const double a = 0.0162;
-    CHECK(rel_equal(cat.make("ngan-ward/blue-acrylic")->eval(wi, wo),
+    CHECK(rel_equal_rgb(cat.make("ngan-ward/blue-acrylic")->eval(wi, wo),
                     kd / M_PI + rho / (4 * M_PI * a * a * c), 1e-13));
   }
   {
     const Rgb kd(0.0137, 0.0326, 0.0637), rho(0.00534, 0.00364, 0.00224);
     const double a = 0.0162;
-    CHECK(rel_equal(cat.make("ngan-ward-duer/blue-acrylic")->eval(wi, wo),
+    CHECK(rel_equal_rgb(cat.make("ngan-ward-duer/blue-acrylic")->eval(wi, wo),
                     kd / M_PI + rho / (4 * M_PI * a * a * c * c), 1e-13));
   }
   {
@@ -187,22 +187,22 @@ TEST_CASE("presets: Ngan 2005 tables evaluate as data/params/README.md states") 
     const Rgb kd(0.0147, 0.0332, 0.064), rho(0.0016, 0.00115, 0.000709);
     const double n = 13700.0;
     const BrdfPtr b = cat.make("ngan-blinn-phong/blue-acrylic");
-    CHECK(rel_equal(b->eval(wi, wo), kd / M_PI + rho * (n + 2) / (2 * M_PI), 1e-13));
+    CHECK(rel_equal_rgb(b->eval(wi, wo), kd / M_PI + rho * (n + 2) / (2 * M_PI), 1e-13));
     const Vec3 a1 = from_spherical(0.305, 0.0), a2 = from_spherical(0.295, M_PI);
-    CHECK(rel_equal(b->eval(a1, a2),
+    CHECK(rel_equal_rgb(b->eval(a1, a2),
                     kd / M_PI + rho * (n + 2) / (2 * M_PI) * std::pow(std::cos(0.005), n), 1e-9));
   }
   {
     // eta column = Schlick F0; D = 1/(pi m^2) at h = n, G = 1: rho F / (pi^2 m^2 c^2).
     const Rgb kd(0.0143, 0.033, 0.0639), rho(0.0291, 0.0193, 0.0118);
     const double m = 0.0137, F = schlick(0.117, c);
-    CHECK(rel_equal(cat.make("ngan-cook-torrance/blue-acrylic")->eval(wi, wo),
+    CHECK(rel_equal_rgb(cat.make("ngan-cook-torrance/blue-acrylic")->eval(wi, wo),
                     kd / M_PI + rho * F / (M_PI * M_PI * m * m * c * c), 1e-12));
   }
   {
     const Rgb kd(0.0143, 0.0331, 0.0639), rho(0.0366, 0.0241, 0.0147);
     const double n = 11600.0, F = schlick(0.0949, c);
-    CHECK(rel_equal(cat.make("ngan-ashikhmin-shirley/blue-acrylic")->eval(wi, wo),
+    CHECK(rel_equal_rgb(cat.make("ngan-ashikhmin-shirley/blue-acrylic")->eval(wi, wo),
                     kd / M_PI + rho * (n + 1) / (8 * M_PI) * F / (c * c), 1e-12));
   }
   {
@@ -210,7 +210,7 @@ TEST_CASE("presets: Ngan 2005 tables evaluate as data/params/README.md states") 
     // and Ngan's 1/max(Cz^2, Cxy^2)^(n/2) makes it (n+2)/(2 pi).
     const Rgb kd(0.0145, 0.0332, 0.064), rho(0.0238, 0.0164, 0.01);
     const double n = 4060.0;
-    CHECK(rel_equal(cat.make("ngan-lafortune/blue-acrylic")->eval(wi, wo),
+    CHECK(rel_equal_rgb(cat.make("ngan-lafortune/blue-acrylic")->eval(wi, wo),
                     kd / M_PI + rho * (n + 2) / (2 * M_PI), 1e-12));
   }
 }
@@ -234,7 +234,7 @@ TEST_CASE("presets: a missing data folder leaves the catalogue working") {
         Approx(0.35 / M_PI));
   CHECK_THROWS_WITH(cat.make("bluepaint"), Contains("unknown BRDF 'bluepaint'"));
   // One table present, the others missing.
-  TempDir dir;
+  PresetDir dir;
   dir.write("ngan2005_ward.csv",
             "material,kd_r,kd_g,kd_b,albedo_r,albedo_g,albedo_b,roughness\n"
             "test-mat,0.1,0.2,0.3,0.01,0.02,0.03,0.1\n");
@@ -247,7 +247,7 @@ TEST_CASE("presets: a missing data folder leaves the catalogue working") {
 }
 
 TEST_CASE("presets: a malformed table is an error naming file, line and rule") {
-  TempDir dir;
+  PresetDir dir;
   const std::string ward_header = "material,kd_r,kd_g,kd_b,albedo_r,albedo_g,albedo_b,roughness\n";
   auto load = [&] {
     Catalogue cat;

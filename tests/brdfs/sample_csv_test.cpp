@@ -23,7 +23,7 @@ namespace fs = std::filesystem;
 
 using bf_test::TempDir;
 
-std::string bad(const std::string& name) {
+std::string bad_csv(const std::string& name) {
   return std::string(BF_TEST_DATA_DIR) + "/measured/" + name;
 }
 
@@ -80,7 +80,7 @@ TEST_CASE("csv: write then read round-trips directions, values, weights and mask
 }
 
 TEST_CASE("csv: masked rows are kept and counted, CRLF and BOM are fine") {
-  const SampleSet s = read_sample_csv(bad("csv_masked.csv"));
+  const SampleSet s = read_sample_csv(bad_csv("csv_masked.csv"));
   REQUIRE(s.size() == 6);
   CHECK(s.valid_count() == 1);
   CHECK(s.invalid_value == 3);  // NaN, negative, overflow (1e999)
@@ -96,10 +96,10 @@ TEST_CASE("csv: masked rows are kept and counted, CRLF and BOM are fine") {
   REQUIRE(b.size() == 1);
   CHECK(b.valid_count() == 1);  // an underflowing value reads as (nearly) 0, not an error
   // A sample list is also a measured BRDF (isotropic interpolation).
-  const BrdfPtr m = Catalogue::builtin().make(bad("csv_masked.csv") + ":k=2");
+  const BrdfPtr m = Catalogue::builtin().make(bad_csv("csv_masked.csv") + ":k=2");
   CHECK(measured_samples(*m).size() == 6);
   CHECK(m->eval(from_spherical(0.1, 0.0), from_spherical(0.2, 3.1)).isApprox(Rgb::Constant(0.5)));
-  CHECK_THROWS_WITH(Catalogue::builtin().make(bad("csv_masked.csv") + ":band=550"),
+  CHECK_THROWS_WITH(Catalogue::builtin().make(bad_csv("csv_masked.csv") + ":band=550"),
                     Contains("unknown parameter 'band' for the .csv loader"));
 }
 
@@ -131,10 +131,10 @@ TEST_CASE("csv: every failure kind gives path:line, expected and found") {
   };
   for (const Case& c : cases) {
     INFO(c.file);
-    CHECK_THROWS_AS(read_sample_csv(bad(c.file)), std::invalid_argument);
-    CHECK_THROWS_WITH(read_sample_csv(bad(c.file)), Contains(c.message));
+    CHECK_THROWS_AS(read_sample_csv(bad_csv(c.file)), std::invalid_argument);
+    CHECK_THROWS_WITH(read_sample_csv(bad_csv(c.file)), Contains(c.message));
   }
-  CHECK_THROWS_WITH(read_sample_csv(bad("absent.csv")), Contains("absent.csv: cannot open"));
+  CHECK_THROWS_WITH(read_sample_csv(bad_csv("absent.csv")), Contains("absent.csv: cannot open"));
   TempDir d("csv_bad");
   {
     std::ofstream f(d.file("long.csv"));

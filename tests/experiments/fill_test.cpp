@@ -17,7 +17,7 @@ using namespace bf_test;
 
 namespace {
 
-std::string config(const std::string& sampling, const std::string& method, const std::string& extra = "") {
+std::string fill_config(const std::string& sampling, const std::string& method, const std::string& extra = "") {
   return "[experiment]\nseed = 3\nplots = false\nrender = false\nexport = false\nvalidation_pairs = 1024\n" +
          extra + "[[brdf]]\nmodel = \"krylon-blue\"\n[sampling]\n" + sampling + "\n[[method]]\n" + method + "\n";
 }
@@ -45,16 +45,16 @@ TEST_CASE("fill: the key applies to measured sets only and bad values name the k
   require_one_config_error("[experiment]\nname = \"t\"\n[[brdf]]\npreset = \"bluepaint\"\n[sampling]\nkind = "
                            "\"grid\"\nresolution = 6\nfill = 0.3\n[[method]]\nkind = \"mccool\"\n",
                            {"sampling.fill", "measured", "grid"});
-  require_one_config_error(config("kind = \"measured\"\nfill = 0.95", "kind = \"mccool\""),
+  require_one_config_error(fill_config("kind = \"measured\"\nfill = 0.95", "kind = \"mccool\""),
                            {"sampling.fill", "0.9", "0.95"});
-  require_one_config_error(config("kind = \"measured\"\nfill = \"always\"", "kind = \"mccool\""),
+  require_one_config_error(fill_config("kind = \"measured\"\nfill = \"always\"", "kind = \"mccool\""),
                            {"sampling.fill", "always", "auto"});
 }
 
 TEST_CASE("fill: the key and its constants are part of a measured sampling's identity") {
   register_loaders();
   const auto identity = [](const std::string& sampling) {
-    return parse_plan(config(sampling, "kind = \"mccool\"\ntexture_size = 4"), "cfg.toml", {}).samplings.at(0);
+    return parse_plan(fill_config(sampling, "kind = \"mccool\"\ntexture_size = 4"), "cfg.toml", {}).samplings.at(0);
   };
   const SamplingVariant a = identity("kind = \"measured\"");
   CHECK(a.fill < 0);
@@ -167,8 +167,8 @@ TEST_CASE("fill: on raw Cornell samples the fit follows the interpolant off the 
   ScratchDir tmp;
   const std::string mccool = "kind = \"mccool\"\ntexture_size = 16";
   const std::string extra = "holdout = 0.1\n";
-  run_quiet(write_text(tmp / "on.toml", config("kind = \"measured\"", mccool, extra)), tmp / "on");
-  run_quiet(write_text(tmp / "off.toml", config("kind = \"measured\"\nfill = \"off\"", mccool, extra)), tmp / "off");
+  run_quiet(write_text(tmp / "on.toml", fill_config("kind = \"measured\"", mccool, extra)), tmp / "on");
+  run_quiet(write_text(tmp / "off.toml", fill_config("kind = \"measured\"\nfill = \"off\"", mccool, extra)), tmp / "off");
   const Row on = read_results_csv(tmp / "on/results.csv").at(0);
   const Row off = read_results_csv(tmp / "off/results.csv").at(0);
   INFO("val " << on.at("val_rel_mse") << " vs " << off.at("val_rel_mse") << ", held-out " << on.at("holdout_rel_mse")

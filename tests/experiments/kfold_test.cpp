@@ -20,7 +20,7 @@ using namespace bf_test;
 namespace {
 
 // n samples whose red value is their index; every 7th (from 4) is masked.
-SampleSet indexed_set(int n) {
+SampleSet kfold_set(int n) {
   SampleSet s;
   for (int k = 0; k < n; ++k) {
     const double phi = 0.1 * k;
@@ -40,7 +40,7 @@ std::vector<int> indices(const SampleSet& s) {
 }  // namespace
 
 TEST_CASE("kfold: folds are disjoint and cover every valid sample once - masked ones stay in training") {
-  const SampleSet s = indexed_set(60);  // 52 valid
+  const SampleSet s = kfold_set(60);  // 52 valid
   for (int k : {2, 3, 5, 52}) {
     INFO("k = " << k);
     const std::vector<HoldoutSplit> f = split_folds(s, k, 9);
@@ -67,7 +67,7 @@ TEST_CASE("kfold: folds are disjoint and cover every valid sample once - masked 
 }
 
 TEST_CASE("kfold: folds are seeded and deterministic") {
-  const SampleSet s = indexed_set(60);
+  const SampleSet s = kfold_set(60);
   const auto a = split_folds(s, 4, 3), b = split_folds(s, 4, 3), c = split_folds(s, 4, 4);
   bool differ = false;
   for (size_t f = 0; f < 4; ++f) {
@@ -78,12 +78,12 @@ TEST_CASE("kfold: folds are seeded and deterministic") {
 }
 
 TEST_CASE("kfold: a number of folds out of range is rejected naming the key and the count") {
-  const SampleSet s = indexed_set(10);  // 9 valid
+  const SampleSet s = kfold_set(10);  // 9 valid
   CHECK_THROWS_WITH(split_folds(s, 1, 1), Catch::Contains("experiment.folds") && Catch::Contains("found 1"));
   CHECK_THROWS_WITH(split_folds(s, 10, 1), Catch::Contains("experiment.folds") && Catch::Contains("9 valid") &&
                                                 Catch::Contains("found 10"));
   CHECK_NOTHROW(split_folds(s, 9, 1));
-  CHECK_THROWS_WITH(split_folds(indexed_set(3), 2, 1), Catch::Contains("experiment.folds"));
+  CHECK_THROWS_WITH(split_folds(kfold_set(3), 2, 1), Catch::Contains("experiment.folds"));
 }
 
 TEST_CASE("kfold: the summary is the folds' mean with their spread") {

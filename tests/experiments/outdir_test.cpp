@@ -32,7 +32,7 @@ std::string many_runs_config(int runs, int resolution = 10) {
          "texture_size = [" + sizes + "]\n";
 }
 
-std::vector<std::string> done_runs(const fs::path& out) {
+std::vector<std::string> done_run_ids(const fs::path& out) {
   std::vector<std::string> ids;
   std::error_code ec;
   if (!fs::exists(out / "runs", ec)) return ids;
@@ -53,7 +53,7 @@ bool wait_until(Child& c, double seconds, Pred pred) {
   return false;
 }
 
-size_t count(const std::string& text, const std::string& what) {
+size_t count_found(const std::string& text, const std::string& what) {
   size_t n = 0;
   for (size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
   return n;
@@ -109,7 +109,7 @@ TEST_CASE("outdir: a second run on the same output folder refuses, naming the ho
   // Wait until the first holds the lock and is inside its runs.
   REQUIRE(wait_until(first, 120, [&] { return fs::exists(out / "runs") && !read_text((out / bf::OutdirLock::kFileName).string()).empty(); }));
   REQUIRE(!wait_child(first, 0));
-  REQUIRE(done_runs(out).size() < 10);
+  REQUIRE(done_run_ids(out).size() < 10);
   std::string second;
   const int rc = run_cli_bounded({"run", cfg, "--out", out.string(), "--no-plots", "-j", "1"}, d / "second.log", 60,
                                  &second);
@@ -131,8 +131,8 @@ TEST_CASE("outdir: a second run on the same output folder refuses, naming the ho
   REQUIRE(ended);
   INFO(read_text(d / "first.log"));
   CHECK(exit_code(first) == 0);
-  CHECK(done_runs(out).size() == 10);
-  CHECK(count(read_text((out / "results.csv").string()), "\n") == 11);
+  CHECK(done_run_ids(out).size() == 10);
+  CHECK(count_found(read_text((out / "results.csv").string()), "\n") == 11);
   // Once the holder is gone the folder is free again (a kernel lock: nothing stale).
   std::string again;
   CHECK(run_cli_bounded({"run", cfg, "--out", out.string(), "--no-plots", "-j", "1"}, d / "third.log", 120, &again) ==
@@ -184,7 +184,7 @@ TEST_CASE("outdir: SIGINT and SIGTERM stop a run cleanly, keep the finished runs
     const std::string cfg = write_text(d / "many.toml", many_runs_config(12));
     const fs::path out = d.path / "out";
     Child c = spawn_cli({"run", cfg, "--out", out.string(), "--no-plots", "-j", "1"}, d / "run.log");
-    REQUIRE(wait_until(c, 120, [&] { return !done_runs(out).empty(); }));
+    REQUIRE(wait_until(c, 120, [&] { return !done_run_ids(out).empty(); }));
     REQUIRE(!wait_child(c, 0));  // still running
     ::kill(c.pid, sig);
     const bool ended = wait_child(c, 60);  // bounded: a run in flight may finish first
@@ -195,13 +195,13 @@ TEST_CASE("outdir: SIGINT and SIGTERM stop a run cleanly, keep the finished runs
     REQUIRE(WIFEXITED(c.status));  // not killed by the signal: it stopped itself
     CHECK(WEXITSTATUS(c.status) == 128 + sig);
     CHECK_THAT(log, Contains("interrupted by " + name) && Contains("run the same command again to resume"));
-    const auto finished = done_runs(out);
+    const auto finished = done_run_ids(out);
     REQUIRE(!finished.empty());
     REQUIRE(finished.size() < 12);
     // The tables hold every run: finished ones ok, the rest marked interrupted.
     const std::string csv = read_text((out / "results.csv").string());
-    CHECK(count(csv, "\n") == 13);
-    CHECK(count(csv, ",interrupted,") + finished.size() >= 12);
+    CHECK(count_found(csv, "\n") == 13);
+    CHECK(count_found(csv, ",interrupted,") + finished.size() >= 12);
     for (const auto& id : finished) CHECK_THAT(csv, Contains(id));
     const std::string md = read_text((out / "results.md").string());
     CHECK_THAT(md, Contains("interrupted"));

@@ -18,14 +18,14 @@ using Catch::Matchers::Contains;
 
 namespace {
 
-const char* const kBase = kConfigHead;
+const char* const kRefineBase = kConfigHead;
 
 // Exactly one message for the head plus `text`, containing every fragment.
 void require_one(const std::string& text, std::initializer_list<std::string> fragments) {
-  require_one_config_error(std::string(kBase) + text, fragments);
+  require_one_config_error(std::string(kRefineBase) + text, fragments);
 }
 
-double num(const Row& r, const std::string& k) {
+double row_num(const Row& r, const std::string& k) {
   INFO(k << " = '" << r.at(k) << "'");
   REQUIRE(!r.at(k).empty());
   return std::stod(r.at(k));
@@ -35,7 +35,7 @@ double num(const Row& r, const std::string& k) {
 
 TEST_CASE("config: refine values and keys of the homomorphic kinds") {
   register_loaders();
-  const Plan p = parse_plan(std::string(kBase) + R"(
+  const Plan p = parse_plan(std::string(kRefineBase) + R"(
 [[method]]
 kind = "mccool"
 refine = ["none", "linear", "cosine", "blend"]
@@ -70,7 +70,7 @@ refine_smoothing = 0.5
   CHECK(homomorphic_options(p.methods[5]).refine.smoothing == 0.5);
   // Every variant is its own run; a refine = "none" run's id does not depend on refine keys.
   CHECK(p.runs.size() == 6);
-  const Plan q = parse_plan(std::string(kBase) + "[[method]]\nkind = \"mccool\"\n", "cfg.toml");
+  const Plan q = parse_plan(std::string(kRefineBase) + "[[method]]\nkind = \"mccool\"\n", "cfg.toml");
   CHECK(q.runs[0].run_id == p.runs[0].run_id);
 }
 
@@ -133,10 +133,10 @@ refine_iterations = 20
                          << lin.at("lin_rmse"));
   // The *_before columns are the unrefined run's metrics.
   for (const char* k : {"rel_mse", "rel_mae", "rel_max", "lin_rmse", "lin_mae", "lin_max", "cos_rmse"})
-    CHECK(num(lin, std::string(k) + "_before") == Approx(num(none, k)).epsilon(1e-6));
-  CHECK(num(lin, "lin_rmse") < 0.9 * num(lin, "lin_rmse_before"));
-  CHECK(num(lin, "refine_seconds") > 0);
-  CHECK(num(lin, "seconds") >= num(lin, "refine_seconds"));
+    CHECK(row_num(lin, std::string(k) + "_before") == Approx(row_num(none, k)).epsilon(1e-6));
+  CHECK(row_num(lin, "lin_rmse") < 0.9 * row_num(lin, "lin_rmse_before"));
+  CHECK(row_num(lin, "refine_seconds") > 0);
+  CHECK(row_num(lin, "seconds") >= row_num(lin, "refine_seconds"));
   CHECK(none.at("rel_mse_before").empty());
 
   // The exported factors are the refined ones: reloading gives the refined metrics.
@@ -145,8 +145,8 @@ refine_iterations = 20
   const BrdfPtr b = Catalogue::builtin().make("bluepaint");
   const SampleSet smp = sample_grid(*b, 6);
   const Metrics m = evaluate_metrics(*back, smp, LogTransform::of(smp, 1e-5));
-  CHECK(m.lin_rmse == Approx(num(lin, "lin_rmse")).epsilon(1e-6));
-  CHECK(m.rel_mse == Approx(num(lin, "rel_mse")).epsilon(1e-6));
+  CHECK(m.lin_rmse == Approx(row_num(lin, "lin_rmse")).epsilon(1e-6));
+  CHECK(m.rel_mse == Approx(row_num(lin, "rel_mse")).epsilon(1e-6));
   const nlohmann::json rec = nlohmann::json::parse(read_text(tmp / ("out/runs/" + lin.at("run_id") + "/run.json")));
   CHECK(rec.at("refinement").at("objective") == "linear");
   CHECK(rec.at("refinement").at("final_cost").get<double>() < rec.at("refinement").at("initial_cost").get<double>());
@@ -181,7 +181,7 @@ starts = 2
     INFO(r.at("model"));
     CHECK(r.at("method") == "model-fit");
     CHECK(r.at("storage_floats") == "7");  // kd, ks (RGB) and a
-    CHECK(num(r, "rel_mse") < 1e-12);      // the model's own data: recovered exactly
+    CHECK(row_num(r, "rel_mse") < 1e-12);      // the model's own data: recovered exactly
     CHECK(r.at("model").rfind("ward:", 0) == 0);
     const std::string file = tmp / ("out/runs/" + r.at("run_id") + "/model.json");
     REQUIRE(fs::exists(file));

@@ -11,7 +11,7 @@ using namespace bf;
 using bf_test::TempDir;
 
 namespace {
-size_t count(const std::string& s, const std::string& what) {
+size_t count_in_page(const std::string& s, const std::string& what) {
   size_t n = 0;
   for (size_t at = s.find(what); at != std::string::npos; at = s.find(what, at + 1)) ++n;
   return n;
@@ -48,8 +48,8 @@ TEST_CASE("report page: notes are folded in a details element on the table and t
   const std::string page = (dir.path / "report.html").string();
   write_report_html(e, f, page);
   const std::string html = bf_test::slurp(page);
-  CHECK(count(html, "<details class=\"notes\">") == 2);
-  CHECK(count(html, note) == 2);  // the whole note, inside the details
+  CHECK(count_in_page(html, "<details class=\"notes\">") == 2);
+  CHECK(count_in_page(html, note) == 2);  // the whole note, inside the details
   const size_t s0 = html.find("<summary>"), s1 = html.find("</summary>");
   REQUIRE(s0 != std::string::npos);
   const std::string summary = html.substr(s0 + 9, s1 - s0 - 9);

@@ -13,7 +13,7 @@ using namespace bf_test;
 
 namespace {
 
-std::string config(const std::string& brdf_line, const std::string& sampling, const std::string& method) {
+std::string symmetry_config(const std::string& brdf_line, const std::string& sampling, const std::string& method) {
   return "[experiment]\nseed = 3\nplots = false\nrender = false\nexport = false\nvalidation_pairs = 512\n"
          "[[brdf]]\n" + brdf_line + "\n[sampling]\n" + sampling + "\n[[method]]\n" + method + "\n";
 }
@@ -34,7 +34,7 @@ TEST_CASE("symmetry run: a planted anisotropic non-reciprocal CSV is never flagg
 
   // Truth = the CSV's interpolant, which assumes symmetries the data do not declare:
   // no whole-domain columns, the reason in `validation`, no flag.
-  run_quiet(write_text(tmp / "a.toml", config("file = \"" + csv + "\"", "kind = \"measured\"", fit)), tmp / "a");
+  run_quiet(write_text(tmp / "a.toml", symmetry_config("file = \"" + csv + "\"", "kind = \"measured\"", fit)), tmp / "a");
   const Row a = read_results_csv(tmp / "a/results.csv").at(0);
   INFO("a: validation = " << a.at("validation") << ", flag = " << a.at("flag"));
   CHECK(a.at("val_rel_mse").empty());
@@ -46,7 +46,7 @@ TEST_CASE("symmetry run: a planted anisotropic non-reciprocal CSV is never flagg
   CHECK(a.at("symmetries") == "none");
 
   // Truth = the analytic model, samples from the CSV: whole-domain columns against it, not flagged.
-  run_quiet(write_text(tmp / "b.toml", config("model = \"separable\"", "kind = \"file\"\npath = \"" + csv + "\"", fit)),
+  run_quiet(write_text(tmp / "b.toml", symmetry_config("model = \"separable\"", "kind = \"file\"\npath = \"" + csv + "\"", fit)),
             tmp / "b");
   const Row b = read_results_csv(tmp / "b/results.csv").at(0);
   INFO("b: validation = " << b.at("validation") << ", val_rel_mse = " << b.at("val_rel_mse") << ", holdout_rel_mse = " << b.at("holdout_rel_mse") << ", rel_mse = " << b.at("rel_mse"));
@@ -60,21 +60,21 @@ TEST_CASE("symmetry run: a planted anisotropic non-reciprocal CSV is never flagg
 TEST_CASE("symmetry run: measured samples use their declared symmetries unless the key says off") {
   ScratchDir tmp;
   const std::string mccool = "kind = \"mccool\"\ntexture_size = 6";
-  run_quiet(write_text(tmp / "a.toml", config("model = \"krylon-blue\"", "kind = \"measured\"", mccool)), tmp / "a");
+  run_quiet(write_text(tmp / "a.toml", symmetry_config("model = \"krylon-blue\"", "kind = \"measured\"", mccool)), tmp / "a");
   const Row a = read_results_csv(tmp / "a/results.csv").at(0);
   CHECK(a.at("symmetries") == "isotropic+reciprocal+bilateral");
   CHECK(!a.at("val_rel_mse").empty());
   const std::string rec = read_text(tmp / ("a/runs/" + a.at("run_id") + "/run.json"));
   CHECK(rec.find("orbit of 8 per sample (2 rotations x swap x mirror)") != std::string::npos);
   run_quiet(write_text(tmp / "b.toml",
-                       config("model = \"krylon-blue\"", "kind = \"measured\"\nsymmetries = \"off\"", mccool)),
+                       symmetry_config("model = \"krylon-blue\"", "kind = \"measured\"\nsymmetries = \"off\"", mccool)),
             tmp / "b");
   const Row b = read_results_csv(tmp / "b/results.csv").at(0);
   CHECK(b.at("symmetries") == "none");
   CHECK(a.at("run_id") != b.at("run_id"));
   CHECK(a.at("samples") == b.at("samples"));  // training metrics stay on the raw samples
   // Grid samples are left alone by default (analytic workloads do not change).
-  run_quiet(write_text(tmp / "c.toml", config("model = \"krylon-blue\"", "kind = \"grid\"\nresolution = 6", mccool)),
+  run_quiet(write_text(tmp / "c.toml", symmetry_config("model = \"krylon-blue\"", "kind = \"grid\"\nresolution = 6", mccool)),
             tmp / "c");
   CHECK(read_results_csv(tmp / "c/results.csv").at(0).at("symmetries") == "none");
 }
@@ -174,7 +174,7 @@ TEST_CASE("symmetry run: the fit set keeps each raw sample at its share and ever
 TEST_CASE("symmetry run: the orbit's settings are part of a raw sampling's identity") {
   register_loaders();
   const auto sampling_identity = [](const std::string& sampling) {
-    const Plan p = parse_plan(config("model = \"krylon-blue\"", sampling, "kind = \"mccool\"\ntexture_size = 4"),
+    const Plan p = parse_plan(symmetry_config("model = \"krylon-blue\"", sampling, "kind = \"mccool\"\ntexture_size = 4"),
                               "cfg.toml", {});
     return p.samplings.at(0).identity;
   };
@@ -196,7 +196,7 @@ TEST_CASE("sample weights: the weights key applies to measured sets only and is 
                            "\"measured\"\nweights = \"solid\"\n[[method]]\nkind = \"mccool\"\n",
                            {"sampling.weights", "solid", "measure"});
   const auto identity = [](const std::string& sampling) {
-    return parse_plan(config("model = \"krylon-blue\"", sampling, "kind = \"mccool\"\ntexture_size = 4"), "cfg.toml",
+    return parse_plan(symmetry_config("model = \"krylon-blue\"", sampling, "kind = \"mccool\"\ntexture_size = 4"), "cfg.toml",
                       {})
         .samplings.at(0)
         .identity;
@@ -210,7 +210,7 @@ TEST_CASE("sample weights: measure weights on scattered samples are refused nami
   ScratchDir tmp;
   std::string out;
   const std::string cfg = write_text(
-      tmp / "w.toml", config("model = \"krylon-blue\"", "kind = \"measured\"\nweights = \"measure\"",
+      tmp / "w.toml", symmetry_config("model = \"krylon-blue\"", "kind = \"measured\"\nweights = \"measure\"",
                              "kind = \"mccool\"\ntexture_size = 4"));
   CHECK(run_cli("run " + cfg + " --out " + (tmp / "o") + " --no-plots", &out) != 0);
   CHECK_THAT(out, Catch::Contains("sampling.weights") && Catch::Contains("MERL"));

@@ -14,16 +14,16 @@ using namespace bf_test;
 
 namespace {
 // One [[method]] table after the common head.
-std::string with_method(const std::string& method) { return std::string(kConfigHead) + "\n[[method]]\n" + method; }
+std::string texture_config(const std::string& method) { return std::string(kConfigHead) + "\n[[method]]\n" + method; }
 
 void require_error(const std::string& method, std::initializer_list<std::string> fragments) {
-  require_one_config_error(with_method(method), fragments);
+  require_one_config_error(texture_config(method), fragments);
 }
 }  // namespace
 
 TEST_CASE("config: texture_size = \"auto\" fills the ladder (svd, mccool, fit)") {
   register_loaders();
-  const Plan p = parse_plan(with_method(R"(kind = "svd"
+  const Plan p = parse_plan(texture_config(R"(kind = "svd"
 texture_size = "auto"
 terms = 6
 tolerance = { metric = "rel_mse", value = 0.05 }
@@ -76,7 +76,7 @@ TEST_CASE("config: texture_size = \"auto\" misuse names the key") {
 
 TEST_CASE("config: a search tolerance caps terms (default 8) and refuses beam > 1") {
   register_loaders();
-  const Plan p = parse_plan(with_method(R"(kind = "search"
+  const Plan p = parse_plan(texture_config(R"(kind = "search"
 tolerance = { metric = "rel_mse", value = 0.05 }
 
 [[method]]

@@ -49,13 +49,13 @@ std::vector<std::string> split_lines(const std::string& text) {
   return out;
 }
 
-std::string row_text(const Row& r) {
+std::string val_row_text(const Row& r) {
   std::string s;
   for (const auto& [k, v] : r) s += k + "=" + v + " ";
   return s;
 }
 
-double num(const Row& r, const std::string& k) {
+double val_num(const Row& r, const std::string& k) {
   INFO(k << " = '" << r.at(k) << "'");
   REQUIRE(!r.at(k).empty());
   return std::stod(r.at(k));
@@ -121,7 +121,7 @@ TEST_CASE("validation: held-out samples are never fitted - perturbing only them 
   run_quiet(write_text(tmp / "a.toml", config(clean)), tmp / "a");
   run_quiet(write_text(tmp / "b.toml", config(perturbed)), tmp / "b");
   const Row ra = read_results_csv(tmp / "a/results.csv").at(0), rb = read_results_csv(tmp / "b/results.csv").at(0);
-  INFO(row_text(ra) << "\n" << row_text(rb));
+  INFO(val_row_text(ra) << "\n" << val_row_text(rb));
   // The fit saw the same training samples: identical training metrics and
   // identical whole-domain scores (the domain set is scored against the BRDF).
   CHECK(ra.at("samples") == std::to_string(split.train.valid_count()));
@@ -129,7 +129,7 @@ TEST_CASE("validation: held-out samples are never fitted - perturbing only them 
   for (const char* k : {"rel_mse", "cos_rmse", "lin_rmse", "val_rel_mse", "val_cos_rmse", "val_max_ratio"})
     CHECK(ra.at(k) == rb.at(k));
   // ...while the held-out metric moves: log(7)^2 ~ 3.8 more in log space.
-  CHECK(num(rb, "holdout_rel_mse") > num(ra, "holdout_rel_mse") + 1.0);
+  CHECK(val_num(rb, "holdout_rel_mse") > val_num(ra, "holdout_rel_mse") + 1.0);
   CHECK(ra.at("validation").find("held out: " + std::to_string(split.held.valid_count()) + " of " +
                                  std::to_string(loaded.valid_count())) != std::string::npos);
 }
@@ -152,9 +152,9 @@ texture_size = 6
 )";
   run_quiet(write_text(tmp / "a.toml", body), tmp / "a");
   const Row r = read_results_csv(tmp / "a/results.csv").at(0);
-  INFO(row_text(r));
-  CHECK(num(r, "shade_rmse") > 0.0);
-  CHECK(num(r, "val_rel_mse") >= 0.0);
+  INFO(val_row_text(r));
+  CHECK(val_num(r, "shade_rmse") > 0.0);
+  CHECK(val_num(r, "val_rel_mse") >= 0.0);
   CHECK(r.at("validation").find("stratified pairs in") != std::string::npos);  // the default, "auto"
   CHECK(r.at("validation").find("blocks of 4096") != std::string::npos);
   CHECK(r.at("holdout_rel_mse").empty());  // grid samples: nothing is held out
@@ -207,7 +207,7 @@ size = 32
     const auto rows = read_results_csv(dir + "/results.csv");
     REQUIRE(rows.size() == cs.sizes.size());
     std::vector<double> shade;
-    for (const auto& r : rows) shade.push_back(num(r, "shade_rmse"));
+    for (const auto& r : rows) shade.push_back(val_num(r, "shade_rmse"));
     std::ostringstream by_size;
     for (double v : shade) by_size << v << " ";
     INFO(cs.kind_body << " shade_rmse by size: " << by_size.str());
@@ -224,10 +224,10 @@ size = 32
     const std::string tdir = tmp / ("t" + std::to_string(ci));
     run_quiet(write_text(tdir + ".toml", head + "[[method]]\n" + cs.tolerance_body + tol.str()), tdir);
     const Row t = read_results_csv(tdir + "/results.csv").at(0);
-    INFO(row_text(t));
+    INFO(val_row_text(t));
     CHECK(t.at(cs.knob) == std::to_string(cs.sizes[expect]));
     CHECK(t.at("tolerance_reached") == "true");
-    CHECK(std::abs(num(t, "shade_rmse") - shade[expect]) <= 1e-9 * shade[expect]);
+    CHECK(std::abs(val_num(t, "shade_rmse") - shade[expect]) <= 1e-9 * shade[expect]);
   }
 }
 
@@ -262,7 +262,7 @@ TEST_CASE("validation: peak_ratio has its closed form and flags mark planted bad
     Row row;
     std::vector<std::string> notes;
     fill_validation_columns(score_validation(Scaled(b, 1.1), &dom, nullptr, lt), 1e-9, "s", row, notes);
-    CHECK(num(row, "val_rel_mse") < kFlagErrorFloor);
+    CHECK(val_num(row, "val_rel_mse") < kFlagErrorFloor);
     CHECK(row.at("flag").empty());
   }
 }

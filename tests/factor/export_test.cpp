@@ -28,16 +28,16 @@ using nlohmann::json;
 namespace {
 
 // A fresh folder under the system temp dir, removed with its contents at scope exit.
-struct TempDir {
+struct ExportDir {
   fs::path path;
-  TempDir() {
+  ExportDir() {
     static int counter = 0;
     path = fs::temp_directory_path() /
            ("bf-export-test-" + std::to_string(::getpid()) + "-" + std::to_string(counter++));
     fs::remove_all(path);
     fs::create_directories(path);
   }
-  ~TempDir() {
+  ~ExportDir() {
     std::error_code ec;
     fs::remove_all(path, ec);
   }
@@ -134,12 +134,12 @@ std::vector<std::pair<Vec3, Vec3>> direction_pairs() {
   return v;
 }
 
-json read_json(const std::string& path) {
+json read_export_json(const std::string& path) {
   std::ifstream in(path);
   return json::parse(in);
 }
 
-void write_json(const std::string& path, const json& j) {
+void write_export_json(const std::string& path, const json& j) {
   std::ofstream out(path);
   out << j.dump(2);
 }
@@ -153,12 +153,12 @@ std::string read_text(const std::string& path) {
 
 // Exports the test factorization to a folder, lets `corrupt` edit the sidecar,
 // and returns the sidecar path.
-std::string corrupted_export(const TempDir& dir, const std::function<void(json&)>& corrupt) {
+std::string corrupted_export(const ExportDir& dir, const std::function<void(json&)>& corrupt) {
   const HomomorphicFactorization f = make_factorization();
   const ExportedFiles files = write_factorization(f, dir.path.string(), "factors");
-  json j = read_json(files.sidecar);
+  json j = read_export_json(files.sidecar);
   corrupt(j);
-  write_json(files.sidecar, j);
+  write_export_json(files.sidecar, j);
   return files.sidecar;
 }
 
@@ -180,7 +180,7 @@ TEST_CASE("export: reload evaluates bit-identically to the in-memory factorizati
     const bool subtract_eps = variant % 2 == 0, ranged = variant >= 2;
     INFO("subtract_eps " << subtract_eps << ", log range " << ranged);
     const HomomorphicFactorization f = make_factorization(subtract_eps, ranged);
-    TempDir dir;
+    ExportDir dir;
     const ExportedFiles files = write_factorization(f, dir.path.string(), "factors");
     for (const std::string& p : files.textures) CHECK(fs::exists(p));
     for (const std::string& p : files.previews) CHECK(fs::exists(p));
@@ -230,9 +230,9 @@ TEST_CASE("export: reload evaluates bit-identically to the in-memory factorizati
 
 TEST_CASE("export: sidecar holds what a renderer needs") {
   const HomomorphicFactorization f = make_factorization();
-  TempDir dir;
+  ExportDir dir;
   const ExportedFiles files = write_factorization(f, dir.path.string(), "factors");
-  const json j = read_json(files.sidecar);
+  const json j = read_export_json(files.sidecar);
   CHECK(j.at("format") == kFactorExportFormat);
   CHECK(j.at("format_version") == kFactorExportFormatVersion);
   CHECK(j.at("glsl") == "factors.glsl");
@@ -307,20 +307,20 @@ TEST_CASE("export: sidecar holds what a renderer needs") {
 
 TEST_CASE("export: the loader names the file, field, expectation and finding") {
   SECTION("missing field") {
-    TempDir dir;
+    ExportDir dir;
     const std::string p = corrupted_export(dir, [](json& j) { j.erase("eps"); });
     REQUIRE_THROWS_WITH(load_factorization(p),
                         Contains(p) && Contains("field 'eps'") && Contains("(0, 1]") &&
                             Contains("field missing"));
   }
   SECTION("missing term field") {
-    TempDir dir;
+    ExportDir dir;
     const std::string p = corrupted_export(dir, [](json& j) { j["terms"][2].erase("matrix"); });
     REQUIRE_THROWS_WITH(load_factorization(p),
                         Contains("field 'terms[2].matrix'") && Contains("field missing"));
   }
   SECTION("wrong type") {
-    TempDir dir;
+    ExportDir dir;
     const std::string p = corrupted_export(dir, [](json& j) { j["terms"][1]["resolution"] = "12"; });
     REQUIRE_THROWS_WITH(load_factorization(p),
                         Contains(p) && Contains("field 'terms[1].resolution'") &&
@@ -328,20 +328,20 @@ TEST_CASE("export: the loader names the file, field, expectation and finding") {
                             Contains("found string \"12\""));
   }
   SECTION("boolean of the wrong type") {
-    TempDir dir;
+    ExportDir dir;
     const std::string p = corrupted_export(dir, [](json& j) { j["terms"][0]["reciprocal"] = 1; });
     REQUIRE_THROWS_WITH(load_factorization(p), Contains("field 'terms[0].reciprocal'") &&
                                                    Contains("expected true or false") &&
                                                    Contains("found number 1"));
   }
   SECTION("resolution out of range") {
-    TempDir dir;
+    ExportDir dir;
     const std::string p = corrupted_export(dir, [](json& j) { j["terms"][0]["resolution"] = 4096; });
     REQUIRE_THROWS_WITH(load_factorization(p), Contains("field 'terms[0].resolution'") &&
                                                    Contains("found number 4096"));
   }
   SECTION("resolution differs from the EXR") {
-    TempDir dir;
+    ExportDir dir;
     const std::string p = corrupted_export(dir, [](json& j) {
       j["terms"][0]["resolution"] = 8;
       j["terms"][0].erase("mask_texels");
@@ -351,12 +351,12 @@ TEST_CASE("export: the loader names the file, field, expectation and finding") {
                                                    Contains("found 16x16"));
   }
   SECTION("mask_texels inconsistent with matrix and resolution") {
-    TempDir dir;
+    ExportDir dir;
     const std::string p = corrupted_export(dir, [](json& j) { j["terms"][0]["resolution"] = 8; });
     REQUIRE_THROWS_WITH(load_factorization(p), Contains("field 'terms[0].mask_texels'"));
   }
   SECTION("matrix of the wrong shape") {
-    TempDir dir;
+    ExportDir dir;
     const std::string p =
         corrupted_export(dir, [](json& j) { j["terms"][1]["matrix"][0] = {1.0, 0.0, 0.0}; });
     REQUIRE_THROWS_WITH(load_factorization(p), Contains("field 'terms[1].matrix[0]'") &&
@@ -364,7 +364,7 @@ TEST_CASE("export: the loader names the file, field, expectation and finding") {
                                                    Contains("found an array of 3"));
   }
   SECTION("NaN in A (JSON has no NaN: it is written as null)") {
-    TempDir dir;
+    ExportDir dir;
     const std::string p =
         corrupted_export(dir, [](json& j) { j["A"][1] = std::numeric_limits<double>::quiet_NaN(); });
     REQUIRE_THROWS_WITH(load_factorization(p), Contains(p) && Contains("field 'A[1]'") &&
@@ -372,7 +372,7 @@ TEST_CASE("export: the loader names the file, field, expectation and finding") {
                                                    Contains("found null"));
   }
   SECTION("literal NaN in the text is invalid JSON") {
-    TempDir dir;
+    ExportDir dir;
     const std::string p = corrupted_export(dir, [](json& j) {});
     std::string text = read_text(p);
     const size_t a = text.find("\"A\": [");
@@ -382,24 +382,24 @@ TEST_CASE("export: the loader names the file, field, expectation and finding") {
     REQUIRE_THROWS_WITH(load_factorization(p), Contains(p) && Contains("invalid JSON"));
   }
   SECTION("A <= 0 and eps out of range") {
-    TempDir dir;
+    ExportDir dir;
     const std::string p = corrupted_export(dir, [](json& j) { j["A"][0] = 0.0; });
     REQUIRE_THROWS_WITH(load_factorization(p), Contains("field 'A[0]'") && Contains("found number 0"));
-    TempDir dir2;
+    ExportDir dir2;
     const std::string q = corrupted_export(dir2, [](json& j) { j["eps"] = 2.0; });
     REQUIRE_THROWS_WITH(load_factorization(q), Contains("field 'eps'") && Contains("found number 2"));
   }
   SECTION("format and version") {
-    TempDir dir;
+    ExportDir dir;
     const std::string p = corrupted_export(dir, [](json& j) { j["format_version"] = 2; });
     REQUIRE_THROWS_WITH(load_factorization(p), Contains("field 'format_version'") &&
                                                    Contains("expected 1") && Contains("found number 2"));
-    TempDir dir2;
+    ExportDir dir2;
     const std::string q = corrupted_export(dir2, [](json& j) { j.erase("format"); });
     REQUIRE_THROWS_WITH(load_factorization(q), Contains("field 'format'") && Contains("field missing"));
   }
   SECTION("unknown parameterization") {
-    TempDir dir;
+    ExportDir dir;
     const std::string p =
         corrupted_export(dir, [](json& j) { j["terms"][0]["parameterization"] = "wohi"; });
     REQUIRE_THROWS_WITH(load_factorization(p), Contains("field 'terms[0].parameterization'") &&
@@ -407,7 +407,7 @@ TEST_CASE("export: the loader names the file, field, expectation and finding") {
                                                    Contains("\"wohi\""));
   }
   SECTION("missing EXR") {
-    TempDir dir;
+    ExportDir dir;
     const std::string p = corrupted_export(dir, [](json& j) {});
     fs::remove(dir / "factors_term1.exr");
     REQUIRE_THROWS_WITH(load_factorization(p), Contains(dir / "factors_term1.exr") &&
@@ -421,7 +421,7 @@ TEST_CASE("export: the loader names the file, field, expectation and finding") {
     size_t inside = 0, outside = 0;
     for (size_t k = 0; k < t.mask.size(); ++k) (t.mask[k] ? inside : outside) = k;
     std::vector<float> px(size_t(R) * R * 3, 0.0f);
-    TempDir dir;
+    ExportDir dir;
     const std::string p = corrupted_export(dir, [](json& j) {});
     px[3 * inside + 1] = std::numeric_limits<float>::quiet_NaN();
     write_exr(dir / "factors_term2.exr", R, R, 3, px);
@@ -439,7 +439,7 @@ TEST_CASE("export: the loader names the file, field, expectation and finding") {
                         Contains("expected 3 channels") && Contains("found 1"));
   }
   SECTION("missing sidecar") {
-    TempDir dir;
+    ExportDir dir;
     REQUIRE_THROWS_WITH(load_factorization(dir / "nope.json"),
                         Contains("nope.json") && Contains("file not found"));
   }
@@ -451,14 +451,14 @@ TEST_CASE("export: a non-finite texel is refused and no file is written") {
   while (!terms[1].mask[k]) ++k;
   terms[1].texels[0][k] = std::numeric_limits<float>::infinity();
   const HomomorphicFactorization f(terms, Rgb(1, 1, 1), 1e-5, true, "fit");
-  TempDir dir;
+  ExportDir dir;
   REQUIRE_THROWS_WITH(write_factorization(f, dir.path.string(), "factors"),
                       Contains("term 1") && Contains("channel R") && Contains("non-finite"));
   CHECK(fs::is_empty(dir.path));
 }
 
 TEST_CASE("export: a failed write leaves the previous export in place") {
-  TempDir dir;
+  ExportDir dir;
   const HomomorphicFactorization f = make_factorization();
   const ExportedFiles files = write_factorization(f, dir.path.string(), "factors");
   const std::string before = read_text(files.sidecar);
@@ -474,7 +474,7 @@ TEST_CASE("export: a failed write leaves the previous export in place") {
 }
 
 TEST_CASE("export: the catalogue loads a sidecar through the .json loader") {
-  TempDir dir;
+  ExportDir dir;
   const HomomorphicFactorization f = make_factorization();
   const ExportedFiles files = write_factorization(f, dir.path.string(), "factors");
   Catalogue cat;
@@ -490,7 +490,7 @@ TEST_CASE("export: generated GLSL compiles for GL 3.3, GL 4.5, GLES 3.0 and Vulk
   INFO("glslangValidator not found: scripts/install-deps.sh installs glslang-tools");
   REQUIRE(std::system("command -v glslangValidator > /dev/null 2>&1") == 0);
   for (const bool ranged : {false, true}) {
-    TempDir dir;
+    ExportDir dir;
     const HomomorphicFactorization f = make_factorization(true, ranged);
     const ExportedFiles files = write_factorization(f, dir.path.string(), "factors");
     const std::string glsl = read_text(files.glsl);
@@ -505,27 +505,27 @@ TEST_CASE("export: generated GLSL compiles for GL 3.3, GL 4.5, GLES 3.0 and Vulk
 
 TEST_CASE("export: a bad log_range is refused naming the field, an absent one means no clamp") {
   SECTION("lo > hi") {
-    TempDir dir;
+    ExportDir dir;
     const std::string p = corrupted_export(dir, [](json& j) { j["log_range"] = {{0, 1}, {2, 1}, {0, 1}}; });
     REQUIRE_THROWS_WITH(load_factorization(p), Contains(p) && Contains("field 'log_range[1]'") &&
                                                    Contains("lo <= hi"));
   }
   SECTION("not a number, wrong shape") {
-    TempDir dir;
+    ExportDir dir;
     const std::string p = corrupted_export(dir, [](json& j) { j["log_range"] = {{0, 1}, {0, 1}, {0, "x"}}; });
     REQUIRE_THROWS_WITH(load_factorization(p), Contains("field 'log_range[2][1]'") && Contains("finite number"));
-    TempDir dir2;
+    ExportDir dir2;
     const std::string q = corrupted_export(dir2, [](json& j) { j["log_range"] = {{0, 1}, {0, 1}}; });
     REQUIRE_THROWS_WITH(load_factorization(q), Contains("field 'log_range'") && Contains("array of 2"));
   }
   SECTION("absent (an export from before the clamp)") {
-    TempDir dir;
+    ExportDir dir;
     const HomomorphicFactorization f = make_factorization(true, true);
     const ExportedFiles files = write_factorization(f, dir.path.string(), "factors");
-    json j = read_json(files.sidecar);
+    json j = read_export_json(files.sidecar);
     REQUIRE(j.contains("log_range"));
     j.erase("log_range");
-    write_json(files.sidecar, j);
+    write_export_json(files.sidecar, j);
     const auto g = load_factorization(files.sidecar);
     CHECK(!g->log_range());
     size_t differ = 0;
@@ -608,7 +608,7 @@ TEST_CASE("export: texture orientation holds through write, read, eval and the G
     terms.push_back(std::move(t));
   }
   const HomomorphicFactorization f(terms, Rgb(0.3, 0.5, 0.7), 1e-5, true, "fit");
-  TempDir dir;
+  ExportDir dir;
   const ExportedFiles files = write_factorization(f, dir.path.string(), "orient");
   REQUIRE(files.textures.size() == 3);
 

@@ -36,12 +36,12 @@ Ward ward() {
   return Ward(p);
 }
 
-json read_json(const std::string& path) {
+json read_sidecar_json(const std::string& path) {
   std::ifstream in(path);
   return json::parse(in);
 }
 
-void write_json(const std::string& path, const json& j) { std::ofstream(path) << j.dump(1); }
+void write_sidecar_json(const std::string& path, const json& j) { std::ofstream(path) << j.dump(1); }
 
 // n float64 zeros (8 n bytes) at path.
 void write_zeros(const std::string& path, size_t n) {
@@ -96,7 +96,7 @@ TEST_CASE("hostile sidecars: the address-space limit of these tests lets a valid
 TEST_CASE("hostile sidecars: sh-r orders beyond the fit's ranges are refused before the table is allocated") {
   TempDir d("hostile_sidecar_shr");
   const BaselineExportFiles files = shr_export(d);
-  json j = read_json(files.sidecar);
+  json j = read_sidecar_json(files.sidecar);
   SECTION("view_order 2000 with a data file that holds its coefficients (48 KB)") {
     // order 0, view order 2000: 2001 coefficients per channel, but a table of
     // 2001^2 per channel (199 MB before the check).
@@ -105,7 +105,7 @@ TEST_CASE("hostile sidecars: sh-r orders beyond the fit's ranges are refused bef
     const size_t M = 2001;
     j["data"]["values"] = 3 * M;
     set_block(j, "rho", 3 * M);
-    write_json(files.sidecar, j);
+    write_sidecar_json(files.sidecar, j);
     write_zeros(files.data, 3 * M);
     CHECK_THROWS_WITH(load_baseline_export(files.sidecar),
                       Contains(files.sidecar) && Contains("field 'view_order': expected an integer in 0..32, found 2000"));
@@ -118,7 +118,7 @@ TEST_CASE("hostile sidecars: sh-r orders beyond the fit's ranges are refused bef
     j["view_order"] = 0;
     j["data"]["values"] = 3 * 2001;
     set_block(j, "rho", 3 * 2001);
-    write_json(files.sidecar, j);
+    write_sidecar_json(files.sidecar, j);
     write_zeros(files.data, 3 * 2001);
     CHECK_THROWS_WITH(load_baseline_export(files.sidecar),
                       Contains(files.sidecar) && Contains("field 'order': expected an integer in 0..200, found 2000"));
@@ -129,7 +129,7 @@ TEST_CASE("hostile sidecars: sh-r orders beyond the fit's ranges are refused bef
     const size_t M = shr_coefficient_count(ShrOptions::kMaxOrder, ShrOptions::kMaxViewOrder);
     j["data"]["values"] = 3 * M;
     set_block(j, "rho", 3 * M);
-    write_json(files.sidecar, j);
+    write_sidecar_json(files.sidecar, j);
     CHECK_THROWS_WITH(load_baseline_export(files.sidecar),
                       Contains(files.data) && Contains("expected " + std::to_string(3 * M * 8) + " bytes") &&
                           Contains("data.values of " + files.sidecar) && Contains("found 192"));
@@ -139,13 +139,13 @@ TEST_CASE("hostile sidecars: sh-r orders beyond the fit's ranges are refused bef
 TEST_CASE("hostile sidecars: data.values is bounded by the data-file cap and by the blocks before the file is read") {
   TempDir d("hostile_sidecar_values");
   const BaselineExportFiles files = shr_export(d);
-  const json j0 = read_json(files.sidecar);
+  const json j0 = read_sidecar_json(files.sidecar);
   const size_t n = 3 * shr_coefficient_count(2, 1);
   REQUIRE(j0["data"]["values"] == n);
   SECTION("2^31 values (16 GiB) are beyond the cap of every data file") {
     json j = j0;
     j["data"]["values"] = 1LL << 31;
-    write_json(files.sidecar, j);
+    write_sidecar_json(files.sidecar, j);
     const std::string msg = "field 'data.values': expected an integer in 0.." +
                             std::to_string(kMaxDataFileBytes / 8) + " (a data file of at most " +
                             std::to_string(kMaxDataFileBytes) + " bytes), found 2147483648";
@@ -157,7 +157,7 @@ TEST_CASE("hostile sidecars: data.values is bounded by the data-file cap and by 
   SECTION("data.values larger than the blocks, with a data file of that size (800 MB, sparse)") {
     json j = j0;
     j["data"]["values"] = 100000000;
-    write_json(files.sidecar, j);
+    write_sidecar_json(files.sidecar, j);
     write_sparse(files.data, 800000000ULL);
     const std::string msg = "field 'data.values': expected " + std::to_string(n) +
                             " (the blocks of order 2 and view_order 1), found 100000000";
@@ -205,10 +205,10 @@ TEST_CASE("hostile sidecars: svd and sh-k sizes are bounded by their option rang
     o.res = 6;
     o.rank = 1;
     const BaselineExportFiles files = write_baseline_export(*fit_svd(ward(), o), d.path.string(), "svd");
-    json j = read_json(files.sidecar);
+    json j = read_sidecar_json(files.sidecar);
     const size_t n = DiskGrid::make(6).count();
     j["rank"] = n + 1;
-    write_json(files.sidecar, j);
+    write_sidecar_json(files.sidecar, j);
     CHECK_THROWS_WITH(load_baseline_export(files.sidecar),
                       Contains("field 'rank': expected an integer in 1.." + std::to_string(n) + ", found " +
                                std::to_string(n + 1)));
@@ -219,7 +219,7 @@ TEST_CASE("hostile sidecars: svd and sh-k sizes are bounded by their option rang
     set_block(j, "sigma", 3 * n256);
     set_block(j, "u", 3 * n256 * 65536);
     set_block(j, "v", 3 * n256 * 65536);
-    write_json(files.sidecar, j);
+    write_sidecar_json(files.sidecar, j);
     CHECK_THROWS_WITH(load_baseline_export(files.sidecar),
                       Contains(files.sidecar) && Contains("data.blocks[") && Contains(".offset") &&
                           Contains("-value data file (data.values)"));
@@ -231,7 +231,7 @@ TEST_CASE("hostile sidecars: svd and sh-k sizes are bounded by their option rang
     o.theta_nodes = 8;
     o.phi_nodes = 16;
     const BaselineExportFiles files = write_baseline_export(*fit_shk(ward(), o), d.path.string(), "shk");
-    const json j0 = read_json(files.sidecar);
+    const json j0 = read_sidecar_json(files.sidecar);
     const std::pair<const char*, json> cases[] = {
         {"order", ShkOptions::kMaxOrder + 1},
         {"view_resolution", ShkOptions::kMaxTextureSize + 1},
@@ -239,13 +239,13 @@ TEST_CASE("hostile sidecars: svd and sh-k sizes are bounded by their option rang
     for (const auto& [key, v] : cases) {
       json j = j0;
       j[key] = v;
-      write_json(files.sidecar, j);
+      write_sidecar_json(files.sidecar, j);
       CHECK_THROWS_WITH(load_baseline_export(files.sidecar), Contains(std::string("field '") + key + "'") &&
                                                                  Contains("found " + v.dump()));
     }
     json j = j0;
     j["quadrature"]["theta_nodes"] = 1 << 20;
-    write_json(files.sidecar, j);
+    write_sidecar_json(files.sidecar, j);
     CHECK_THROWS_WITH(load_baseline_export(files.sidecar),
                       Contains("field 'theta_nodes': expected an integer in 1.." +
                                std::to_string(ShkOptions::kMaxThetaNodes) + ", found 1048576"));
@@ -256,7 +256,7 @@ TEST_CASE("hostile sidecars: svd and sh-k sizes are bounded by their option rang
     const size_t count = size_t(3) * 101 * 101 * 512 * 512;
     j["data"]["values"] = 1000;
     set_block(j, "coefficients", count);
-    write_json(files.sidecar, j);
+    write_sidecar_json(files.sidecar, j);
     CHECK_THROWS_WITH(load_baseline_export(files.sidecar),
                       Contains(files.sidecar) && Contains(".offset") && Contains("-value data file (data.values)"));
   }
