@@ -5,8 +5,9 @@
 # under them, but for the tests tagged [heavy] (ctest -LE 'slow|heavy': repeats
 # of code paths the other tests run; docs/testing.md). Any finding makes a
 # test, and so this script, fail.
-#   scripts/test-sanitize.sh              every default test
-#   scripts/test-sanitize.sh REGEX        only tests whose name matches (ctest -R)
+#   scripts/test-sanitize.sh              every default test but the [heavy] ones
+#   scripts/test-sanitize.sh REGEX        only default tests whose name matches
+#                                         (ctest -R), [heavy] ones included
 # Build dir: $BF_ASAN_BUILD_DIR (default build-asan). Needs only the default
 # packages (gcc ships libasan/libubsan): scripts/install-deps.sh.
 set -euo pipefail
@@ -26,8 +27,8 @@ export UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1"
 # The whole suite: CTest must register exactly the Catch2 test cases.
 [ -z "${1:-}" ] && bash scripts/check-test-count.sh "$build"
 cd "$build"
-args=(-LE 'slow|heavy' --no-tests=error --output-on-failure -j "$(nproc)" --timeout 1800)
-[ -n "${1:-}" ] && args+=(-R "$1")
+args=(--no-tests=error --output-on-failure -j "$(nproc)" --timeout 1800)
+if [ -n "${1:-}" ]; then args+=(-LE slow -R "$1"); else args+=(-LE 'slow|heavy'); fi
 status=0
 ctest "${args[@]}" || status=$?
 end=$(date +%s)
