@@ -41,6 +41,11 @@ struct TempDir {
     std::filesystem::remove_all(path, ec);
   }
   std::string file(const std::string& name) const { return (path / name).string(); }
+  // Writes `text` to the file `name` in the folder and returns its path.
+  std::string write(const std::string& name, const std::string& text) const {
+    std::ofstream(path / name) << text;
+    return file(name);
+  }
 };
 
 // The whole file as bytes ("" when it cannot be read).

@@ -1,7 +1,6 @@
 // Tests of the named presets: presence, pbrt-v1 bluepaint against its formula
 // (also through the CLI), the Ngan 2005 tables as data/params/README.md reads
 // them, and robustness to missing or malformed parameter tables.
-#include <unistd.h>
 
 #include <cstdio>
 #include <filesystem>
@@ -64,21 +63,6 @@ std::string params_dir() {
   return data_dir() + "/params";
 }
 
-// A scratch folder under the system temp dir, removed at scope exit.
-struct PresetDir {
-  fs::path path;
-  PresetDir() {
-    static int counter = 0;
-    path = fs::temp_directory_path() /
-           ("bf-presets-test-" + std::to_string(::getpid()) + "-" + std::to_string(++counter));
-    fs::remove_all(path);
-    fs::create_directories(path);
-  }
-  ~PresetDir() { fs::remove_all(path); }
-  void write(const std::string& name, const std::string& text) const {
-    std::ofstream(path / name) << text;
-  }
-};
 
 std::string error_of(const std::function<void()>& f) {
   try {
@@ -234,7 +218,7 @@ TEST_CASE("presets: a missing data folder leaves the catalogue working") {
         Approx(0.35 / M_PI));
   CHECK_THROWS_WITH(cat.make("bluepaint"), Contains("unknown BRDF 'bluepaint'"));
   // One table present, the others missing.
-  PresetDir dir;
+  const bf_test::TempDir dir("presets");
   dir.write("ngan2005_ward.csv",
             "material,kd_r,kd_g,kd_b,albedo_r,albedo_g,albedo_b,roughness\n"
             "test-mat,0.1,0.2,0.3,0.01,0.02,0.03,0.1\n");
@@ -247,7 +231,7 @@ TEST_CASE("presets: a missing data folder leaves the catalogue working") {
 }
 
 TEST_CASE("presets: a malformed table is an error naming file, line and rule") {
-  PresetDir dir;
+  const bf_test::TempDir dir("presets");
   const std::string ward_header = "material,kd_r,kd_g,kd_b,albedo_r,albedo_g,albedo_b,roughness\n";
   auto load = [&] {
     Catalogue cat;

@@ -2,7 +2,6 @@
 // validation messages, atomic writes, catalogue registration, and the
 // generated GLSL compiled by glslangValidator.
 #include <array>
-#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
@@ -27,22 +26,7 @@ using nlohmann::json;
 
 namespace {
 
-// A fresh folder under the system temp dir, removed with its contents at scope exit.
-struct ExportDir {
-  fs::path path;
-  ExportDir() {
-    static int counter = 0;
-    path = fs::temp_directory_path() /
-           ("bf-export-test-" + std::to_string(::getpid()) + "-" + std::to_string(counter++));
-    fs::remove_all(path);
-    fs::create_directories(path);
-  }
-  ~ExportDir() {
-    std::error_code ec;
-    fs::remove_all(path, ec);
-  }
-  std::string operator/(const std::string& name) const { return (path / name).string(); }
-};
+using bf_test::TempDir;
 
 Mat24 random_orthonormal(std::mt19937_64& rng) {
   std::normal_distribution<double> N(0.0, 1.0);
@@ -153,7 +137,7 @@ std::string read_text(const std::string& path) {
 
 // Exports the test factorization to a folder, lets `corrupt` edit the sidecar,
 // and returns the sidecar path.
-std::string corrupted_export(const ExportDir& dir, const std::function<void(json&)>& corrupt) {
+std::string corrupted_export(const TempDir& dir, const std::function<void(json&)>& corrupt) {
   const HomomorphicFactorization f = make_factorization();
   const ExportedFiles files = write_factorization(f, dir.path.string(), "factors");
   json j = read_export_json(files.sidecar);
@@ -180,7 +164,7 @@ TEST_CASE("export: reload evaluates bit-identically to the in-memory factorizati
     const bool subtract_eps = variant % 2 == 0, ranged = variant >= 2;
     INFO("subtract_eps " << subtract_eps << ", log range " << ranged);
     const HomomorphicFactorization f = make_factorization(subtract_eps, ranged);
-    ExportDir dir;
+    TempDir dir("export");
     const ExportedFiles files = write_factorization(f, dir.path.string(), "factors");
     for (const std::string& p : files.textures) CHECK(fs::exists(p));
     for (const std::string& p : files.previews) CHECK(fs::exists(p));
@@ -230,7 +214,7 @@ TEST_CASE("export: reload evaluates bit-identically to the in-memory factorizati
 
 TEST_CASE("export: sidecar holds what a renderer needs") {
   const HomomorphicFactorization f = make_factorization();
-  ExportDir dir;
+  TempDir dir("export");
   const ExportedFiles files = write_factorization(f, dir.path.string(), "factors");
   const json j = read_export_json(files.sidecar);
   CHECK(j.at("format") == kFactorExportFormat);
@@ -307,20 +291,20 @@ TEST_CASE("export: sidecar holds what a renderer needs") {
 
 TEST_CASE("export: the loader names the file, field, expectation and finding") {
   SECTION("missing field") {
-    ExportDir dir;
+    TempDir dir("export");
     const std::string p = corrupted_export(dir, [](json& j) { j.erase("eps"); });
     REQUIRE_THROWS_WITH(load_factorization(p),
                         Contains(p) && Contains("field 'eps'") && Contains("(0, 1]") &&
                             Contains("field missing"));
   }
   SECTION("missing term field") {
-    ExportDir dir;
+    TempDir dir("export");
     const std::string p = corrupted_export(dir, [](json& j) { j["terms"][2].erase("matrix"); });
     REQUIRE_THROWS_WITH(load_factorization(p),
                         Contains("field 'terms[2].matrix'") && Contains("field missing"));
   }
   SECTION("wrong type") {
-    ExportDir dir;
+    TempDir dir("export");
     const std::string p = corrupted_export(dir, [](json& j) { j["terms"][1]["resolution"] = "12"; });
     REQUIRE_THROWS_WITH(load_factorization(p),
                         Contains(p) && Contains("field 'terms[1].resolution'") &&
@@ -328,20 +312,20 @@ TEST_CASE("export: the loader names the file, field, expectation and finding") {
                             Contains("found string \"12\""));
   }
   SECTION("boolean of the wrong type") {
-    ExportDir dir;
+    TempDir dir("export");
     const std::string p = corrupted_export(dir, [](json& j) { j["terms"][0]["reciprocal"] = 1; });
     REQUIRE_THROWS_WITH(load_factorization(p), Contains("field 'terms[0].reciprocal'") &&
                                                    Contains("expected true or false") &&
                                                    Contains("found number 1"));
   }
   SECTION("resolution out of range") {
-    ExportDir dir;
+    TempDir dir("export");
     const std::string p = corrupted_export(dir, [](json& j) { j["terms"][0]["resolution"] = 4096; });
     REQUIRE_THROWS_WITH(load_factorization(p), Contains("field 'terms[0].resolution'") &&
                                                    Contains("found number 4096"));
   }
   SECTION("resolution differs from the EXR") {
-    ExportDir dir;
+    TempDir dir("export");
     const std::string p = corrupted_export(dir, [](json& j) {
       j["terms"][0]["resolution"] = 8;
       j["terms"][0].erase("mask_texels");
@@ -351,12 +335,12 @@ TEST_CASE("export: the loader names the file, field, expectation and finding") {
                                                    Contains("found 16x16"));
   }
   SECTION("mask_texels inconsistent with matrix and resolution") {
-    ExportDir dir;
+    TempDir dir("export");
     const std::string p = corrupted_export(dir, [](json& j) { j["terms"][0]["resolution"] = 8; });
     REQUIRE_THROWS_WITH(load_factorization(p), Contains("field 'terms[0].mask_texels'"));
   }
   SECTION("matrix of the wrong shape") {
-    ExportDir dir;
+    TempDir dir("export");
     const std::string p =
         corrupted_export(dir, [](json& j) { j["terms"][1]["matrix"][0] = {1.0, 0.0, 0.0}; });
     REQUIRE_THROWS_WITH(load_factorization(p), Contains("field 'terms[1].matrix[0]'") &&
@@ -364,7 +348,7 @@ TEST_CASE("export: the loader names the file, field, expectation and finding") {
                                                    Contains("found an array of 3"));
   }
   SECTION("NaN in A (JSON has no NaN: it is written as null)") {
-    ExportDir dir;
+    TempDir dir("export");
     const std::string p =
         corrupted_export(dir, [](json& j) { j["A"][1] = std::numeric_limits<double>::quiet_NaN(); });
     REQUIRE_THROWS_WITH(load_factorization(p), Contains(p) && Contains("field 'A[1]'") &&
@@ -372,7 +356,7 @@ TEST_CASE("export: the loader names the file, field, expectation and finding") {
                                                    Contains("found null"));
   }
   SECTION("literal NaN in the text is invalid JSON") {
-    ExportDir dir;
+    TempDir dir("export");
     const std::string p = corrupted_export(dir, [](json& j) {});
     std::string text = read_text(p);
     const size_t a = text.find("\"A\": [");
@@ -382,24 +366,24 @@ TEST_CASE("export: the loader names the file, field, expectation and finding") {
     REQUIRE_THROWS_WITH(load_factorization(p), Contains(p) && Contains("invalid JSON"));
   }
   SECTION("A <= 0 and eps out of range") {
-    ExportDir dir;
+    TempDir dir("export");
     const std::string p = corrupted_export(dir, [](json& j) { j["A"][0] = 0.0; });
     REQUIRE_THROWS_WITH(load_factorization(p), Contains("field 'A[0]'") && Contains("found number 0"));
-    ExportDir dir2;
+    TempDir dir2("export");
     const std::string q = corrupted_export(dir2, [](json& j) { j["eps"] = 2.0; });
     REQUIRE_THROWS_WITH(load_factorization(q), Contains("field 'eps'") && Contains("found number 2"));
   }
   SECTION("format and version") {
-    ExportDir dir;
+    TempDir dir("export");
     const std::string p = corrupted_export(dir, [](json& j) { j["format_version"] = 2; });
     REQUIRE_THROWS_WITH(load_factorization(p), Contains("field 'format_version'") &&
                                                    Contains("expected 1") && Contains("found number 2"));
-    ExportDir dir2;
+    TempDir dir2("export");
     const std::string q = corrupted_export(dir2, [](json& j) { j.erase("format"); });
     REQUIRE_THROWS_WITH(load_factorization(q), Contains("field 'format'") && Contains("field missing"));
   }
   SECTION("unknown parameterization") {
-    ExportDir dir;
+    TempDir dir("export");
     const std::string p =
         corrupted_export(dir, [](json& j) { j["terms"][0]["parameterization"] = "wohi"; });
     REQUIRE_THROWS_WITH(load_factorization(p), Contains("field 'terms[0].parameterization'") &&
@@ -407,10 +391,10 @@ TEST_CASE("export: the loader names the file, field, expectation and finding") {
                                                    Contains("\"wohi\""));
   }
   SECTION("missing EXR") {
-    ExportDir dir;
+    TempDir dir("export");
     const std::string p = corrupted_export(dir, [](json& j) {});
-    fs::remove(dir / "factors_term1.exr");
-    REQUIRE_THROWS_WITH(load_factorization(p), Contains(dir / "factors_term1.exr") &&
+    fs::remove(dir.file("factors_term1.exr"));
+    REQUIRE_THROWS_WITH(load_factorization(p), Contains(dir.file("factors_term1.exr")) &&
                                                    Contains("terms[1].texture") &&
                                                    Contains("file not found"));
   }
@@ -421,26 +405,26 @@ TEST_CASE("export: the loader names the file, field, expectation and finding") {
     size_t inside = 0, outside = 0;
     for (size_t k = 0; k < t.mask.size(); ++k) (t.mask[k] ? inside : outside) = k;
     std::vector<float> px(size_t(R) * R * 3, 0.0f);
-    ExportDir dir;
+    TempDir dir("export");
     const std::string p = corrupted_export(dir, [](json& j) {});
     px[3 * inside + 1] = std::numeric_limits<float>::quiet_NaN();
-    write_exr(dir / "factors_term2.exr", R, R, 3, px);
+    write_exr(dir.file("factors_term2.exr"), R, R, 3, px);
     REQUIRE_THROWS_WITH(load_factorization(p), Contains("factors_term2.exr") &&
                                                    Contains("channel G") &&
                                                    Contains("expected a finite value"));
     if (outside != inside && !t.mask[outside]) {
       px.assign(px.size(), 0.0f);
       px[3 * outside] = 1.0f;
-      write_exr(dir / "factors_term2.exr", R, R, 3, px);
+      write_exr(dir.file("factors_term2.exr"), R, R, 3, px);
       REQUIRE_THROWS_WITH(load_factorization(p), Contains("outside the projection mask"));
     }
-    write_exr(dir / "factors_term2.exr", R, R, 1, std::vector<float>(size_t(R) * R, 0.0f));
+    write_exr(dir.file("factors_term2.exr"), R, R, 1, std::vector<float>(size_t(R) * R, 0.0f));
     REQUIRE_THROWS_WITH(load_factorization(p),
                         Contains("expected 3 channels") && Contains("found 1"));
   }
   SECTION("missing sidecar") {
-    ExportDir dir;
-    REQUIRE_THROWS_WITH(load_factorization(dir / "nope.json"),
+    TempDir dir("export");
+    REQUIRE_THROWS_WITH(load_factorization(dir.file("nope.json")),
                         Contains("nope.json") && Contains("file not found"));
   }
 }
@@ -451,14 +435,14 @@ TEST_CASE("export: a non-finite texel is refused and no file is written") {
   while (!terms[1].mask[k]) ++k;
   terms[1].texels[0][k] = std::numeric_limits<float>::infinity();
   const HomomorphicFactorization f(terms, Rgb(1, 1, 1), 1e-5, true, "fit");
-  ExportDir dir;
+  TempDir dir("export");
   REQUIRE_THROWS_WITH(write_factorization(f, dir.path.string(), "factors"),
                       Contains("term 1") && Contains("channel R") && Contains("non-finite"));
   CHECK(fs::is_empty(dir.path));
 }
 
 TEST_CASE("export: a failed write leaves the previous export in place") {
-  ExportDir dir;
+  TempDir dir("export");
   const HomomorphicFactorization f = make_factorization();
   const ExportedFiles files = write_factorization(f, dir.path.string(), "factors");
   const std::string before = read_text(files.sidecar);
@@ -474,7 +458,7 @@ TEST_CASE("export: a failed write leaves the previous export in place") {
 }
 
 TEST_CASE("export: the catalogue loads a sidecar through the .json loader") {
-  ExportDir dir;
+  TempDir dir("export");
   const HomomorphicFactorization f = make_factorization();
   const ExportedFiles files = write_factorization(f, dir.path.string(), "factors");
   Catalogue cat;
@@ -490,7 +474,7 @@ TEST_CASE("export: generated GLSL compiles for GL 3.3, GL 4.5, GLES 3.0 and Vulk
   INFO("glslangValidator not found: scripts/install-deps.sh installs glslang-tools");
   REQUIRE(std::system("command -v glslangValidator > /dev/null 2>&1") == 0);
   for (const bool ranged : {false, true}) {
-    ExportDir dir;
+    TempDir dir("export");
     const HomomorphicFactorization f = make_factorization(true, ranged);
     const ExportedFiles files = write_factorization(f, dir.path.string(), "factors");
     const std::string glsl = read_text(files.glsl);
@@ -505,21 +489,21 @@ TEST_CASE("export: generated GLSL compiles for GL 3.3, GL 4.5, GLES 3.0 and Vulk
 
 TEST_CASE("export: a bad log_range is refused naming the field, an absent one means no clamp") {
   SECTION("lo > hi") {
-    ExportDir dir;
+    TempDir dir("export");
     const std::string p = corrupted_export(dir, [](json& j) { j["log_range"] = {{0, 1}, {2, 1}, {0, 1}}; });
     REQUIRE_THROWS_WITH(load_factorization(p), Contains(p) && Contains("field 'log_range[1]'") &&
                                                    Contains("lo <= hi"));
   }
   SECTION("not a number, wrong shape") {
-    ExportDir dir;
+    TempDir dir("export");
     const std::string p = corrupted_export(dir, [](json& j) { j["log_range"] = {{0, 1}, {0, 1}, {0, "x"}}; });
     REQUIRE_THROWS_WITH(load_factorization(p), Contains("field 'log_range[2][1]'") && Contains("finite number"));
-    ExportDir dir2;
+    TempDir dir2("export");
     const std::string q = corrupted_export(dir2, [](json& j) { j["log_range"] = {{0, 1}, {0, 1}}; });
     REQUIRE_THROWS_WITH(load_factorization(q), Contains("field 'log_range'") && Contains("array of 2"));
   }
   SECTION("absent (an export from before the clamp)") {
-    ExportDir dir;
+    TempDir dir("export");
     const HomomorphicFactorization f = make_factorization(true, true);
     const ExportedFiles files = write_factorization(f, dir.path.string(), "factors");
     json j = read_export_json(files.sidecar);
@@ -608,7 +592,7 @@ TEST_CASE("export: texture orientation holds through write, read, eval and the G
     terms.push_back(std::move(t));
   }
   const HomomorphicFactorization f(terms, Rgb(0.3, 0.5, 0.7), 1e-5, true, "fit");
-  ExportDir dir;
+  TempDir dir("export");
   const ExportedFiles files = write_factorization(f, dir.path.string(), "orient");
   REQUIRE(files.textures.size() == 3);
 
@@ -659,7 +643,7 @@ TEST_CASE("export: texture orientation holds through write, read, eval and the G
   INFO("GLSL runner " << runner.string() << " (built with the tests; needs Mesa's EGL: scripts/install-deps.sh)");
   REQUIRE(fs::exists(runner));
   {
-    std::ofstream d(dir / "dirs.txt");
+    std::ofstream d(dir.file("dirs.txt"));
     d.precision(17);
     for (const auto& [wi, wo] : pairs)
       d << wi.x() << " " << wi.y() << " " << wi.z() << " " << wo.x() << " " << wo.y() << " " << wo.z() << "\n";
@@ -674,21 +658,21 @@ TEST_CASE("export: texture orientation holds through write, read, eval and the G
     range[c] = {v[v.size() / 4], v[3 * v.size() / 4]};
   }
   const HomomorphicFactorization fr(terms, f.A(), f.eps(), true, "fit", range);
-  fs::create_directories(dir / "ranged");
-  const ExportedFiles rfiles = write_factorization(fr, dir / "ranged", "orient");
+  fs::create_directories(dir.file("ranged"));
+  const ExportedFiles rfiles = write_factorization(fr, dir.file("ranged"), "orient");
   for (int variant = 0; variant < 4; ++variant) {
     const bool exact = variant % 2 == 0, ranged = variant >= 2;
     const HomomorphicFactorization& fv = ranged ? fr : f;
     const ExportedFiles& fl = ranged ? rfiles : files;
-    std::string cmd = runner.string() + " " + fl.glsl + " " + (dir / "dirs.txt") + " " + (dir / "out.txt") +
+    std::string cmd = runner.string() + " " + fl.glsl + " " + (dir.file("dirs.txt")) + " " + (dir.file("out.txt")) +
                       (exact ? " --exact" : "");
     for (const auto& t : fl.textures) cmd += " " + t;
-    cmd += " > " + (dir / "run.log") + " 2>&1";
+    cmd += " > " + (dir.file("run.log")) + " 2>&1";
     const int rc = std::system(cmd.c_str());
     INFO((exact ? "texelFetch path" : "hardware bilinear path") << (ranged ? ", log range clamped" : "") << ": "
-                                                                   << read_text(dir / "run.log"));
+                                                                   << read_text(dir.file("run.log")));
     REQUIRE(rc == 0);
-    std::ifstream out(dir / "out.txt");
+    std::ifstream out(dir.file("out.txt"));
     double worst = 0.0;
     size_t n = 0, clamped = 0;
     for (const auto& [wi, wo] : pairs) {

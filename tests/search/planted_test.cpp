@@ -814,7 +814,7 @@ struct StopRuleCase {
   const SampleSet s = sample_grid(*b, 8);
   const FitData d{s, 1e-5};
   const LogTransform lt = LogTransform::of(s, 1e-5);
-  SearchOptions opt = options();
+  const SearchOptions opt = options();
   std::vector<std::pair<size_t, double>> seen;  // (terms, rel_mse) of what the rule is shown
   SearchResult all;
 
@@ -835,6 +835,14 @@ struct StopRuleCase {
   }
   // A tolerance between the 2-term answer and its reciprocal refit (lower here).
   double target() const { return 0.5 * (seen.at(2).second + seen.at(3).second); }
+  // The options with a stopping rule that accepts an answer at or below `tol`.
+  SearchOptions stopping_at(double tol) const {
+    SearchOptions o = opt;
+    o.stop_after_term = [this, tol](const HomomorphicFactorization& h) {
+      return evaluate_metrics(h, s, lt).rel_mse <= tol;
+    };
+    return o;
+  }
 };
 
 }  // namespace
@@ -853,9 +861,7 @@ TEST_CASE("structured search: a stopping rule judges the answer final_reciprocit
   REQUIRE(c.seen[3].second < c.seen[2].second);
   REQUIRE(c.seen[1].second > c.seen[2].second);
   const double target = c.target();
-  SearchOptions opt = c.opt;
-  opt.stop_after_term = [&](const HomomorphicFactorization& h) { return evaluate_metrics(h, c.s, c.lt).rel_mse <= target; };
-  const SearchResult two = search_factorization(c.d, opt);
+  const SearchResult two = search_factorization(c.d, c.stopping_at(target));
   REQUIRE(two.rel_mse_after_term.size() == 2);
   CHECK(two.reciprocal_answers.at(1));
   CHECK(evaluate_metrics(*two.factorization, c.s, c.lt).rel_mse <= target);
@@ -872,10 +878,8 @@ TEST_CASE("structured search: a stopping rule changes nothing in the search and 
   CHECK(c.all.evaluations == none.evaluations + 4);
   // Without the reciprocal answers the tolerance the 2-term reciprocal
   // refit meets takes a third term.
-  const double target = c.target();
-  SearchOptions opt = c.opt;
+  SearchOptions opt = c.stopping_at(c.target());
   opt.final_reciprocity = false;
-  opt.stop_after_term = [&](const HomomorphicFactorization& h) { return evaluate_metrics(h, c.s, c.lt).rel_mse <= target; };
   CHECK(search_factorization(c.d, opt).rel_mse_after_term.size() == 3);
 }
 
